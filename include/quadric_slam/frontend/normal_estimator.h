@@ -1,0 +1,43 @@
+// Surface normals of an organized cloud with PCL's integral-image estimator (Holzer et al. 2012,
+// the method the paper uses, Section IV).
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <string>
+
+namespace quadric_slam {
+
+class NormalEstimator {
+ public:
+  struct Params {
+    // PCL integral-image method: average_3d_gradient, covariance_matrix, average_depth_change
+    // or simple_3d_gradient.
+    std::string method = "average_3d_gradient";
+    // Depth discontinuity threshold: neighbours differing by more than factor * depth are not
+    // smoothed across (dimensionless).
+    double max_depth_change_factor = 0.02;
+    // Smoothing window half-size (pixels of the organized cloud); scaled with depth when
+    // depth_dependent_smoothing is set.
+    double normal_smoothing_size = 10.0;
+    bool depth_dependent_smoothing = true;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  explicit NormalEstimator(const Params& params);
+
+  // Normals of an organized cloud, oriented towards the sensor origin. The output has the input's
+  // size and points; where a normal cannot be estimated (no data, discontinuity, border) its
+  // normal and curvature are NaN. Throws std::invalid_argument for an unorganized cloud.
+  pcl::PointCloud<pcl::PointNormal> compute(const pcl::PointCloud<pcl::PointXYZ>& cloud) const;
+
+  const Params& params() const { return params_; }
+
+ private:
+  Params params_;
+};
+
+}  // namespace quadric_slam

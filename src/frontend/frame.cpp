@@ -1,0 +1,46 @@
+#include "quadric_slam/frontend/frame.h"
+
+#include <sstream>
+#include <stdexcept>
+
+namespace quadric_slam {
+
+std::string CameraIntrinsics::problem() const {
+  std::ostringstream why;
+  if (!(fx > 0) || !(fy > 0) || !std::isfinite(fx) || !std::isfinite(fy)) {
+    why << "focal lengths must be positive and finite (fx " << fx << ", fy " << fy << ")";
+  } else if (!std::isfinite(cx) || !std::isfinite(cy)) {
+    why << "principal point must be finite";
+  } else if (width <= 0 || height <= 0) {
+    why << "image size must be positive (" << width << " x " << height << ")";
+  }
+  return why.str();
+}
+
+void BackProjectionParams::validate() const {
+  if (decimation < 1 || decimation > 16) {
+    throw std::invalid_argument("decimation must be in [1, 16], got " + std::to_string(decimation));
+  }
+  if (!(min_range >= 0.0)) {
+    throw std::invalid_argument("min_range must be >= 0 m, got " + std::to_string(min_range));
+  }
+  if (!(max_range > min_range)) {
+    throw std::invalid_argument("max_range must be > min_range (" + std::to_string(min_range) +
+                                " m), got " + std::to_string(max_range));
+  }
+}
+
+std::string imageSizeProblem(const CameraIntrinsics& intrinsics, int width, int height) {
+  const std::string intrinsics_problem = intrinsics.problem();
+  if (!intrinsics_problem.empty())
+    return "invalid intrinsics: " + intrinsics_problem;
+  if (width != intrinsics.width || height != intrinsics.height) {
+    std::ostringstream why;
+    why << "depth image is " << width << " x " << height << " but camera_info says "
+        << intrinsics.width << " x " << intrinsics.height;
+    return why.str();
+  }
+  return "";
+}
+
+}  // namespace quadric_slam

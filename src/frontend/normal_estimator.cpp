@@ -1,0 +1,93 @@
+#include "quadric_slam/frontend/normal_estimator.h"
+
+#include <pcl/features/integral_image_normal.h>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace quadric_slam {
+namespace {
+
+using Estimator = pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal>;
+
+Estimator::NormalEstimationMethod methodFromName(const std::string& name) {
+  if (name == "average_3d_gradient")
+    return Estimator::AVERAGE_3D_GRADIENT;
+  if (name == "covariance_matrix")
+    return Estimator::COVARIANCE_MATRIX;
+  if (name == "average_depth_change")
+    return Estimator::AVERAGE_DEPTH_CHANGE;
+  if (name == "simple_3d_gradient")
+    return Estimator::SIMPLE_3D_GRADIENT;
+  throw std::invalid_argument(
+      "method must be one of average_3d_gradient, covariance_matrix, "
+      "average_depth_change, simple_3d_gradient; got '" +
+      name + "'");
+}
+
+}  // namespace
+
+void NormalEstimator::Params::validate() const {
+  methodFromName(method);
+  if (!(max_depth_change_factor > 0.0 && max_depth_change_factor <= 1.0)) {
+    throw std::invalid_argument("max_depth_change_factor must be in (0, 1], got " +
+                                std::to_string(max_depth_change_factor));
+  }
+  if (!(normal_smoothing_size >= 1.0 && normal_smoothing_size <= 100.0)) {
+    throw std::invalid_argument("normal_smoothing_size must be in [1, 100] pixels, got " +
+                                std::to_string(normal_smoothing_size));
+  }
+}
+
+NormalEstimator::NormalEstimator(const Params& params) : params_(params) {
+  params_.validate();
+}
+
+pcl::PointCloud<pcl::PointNormal> NormalEstimator::compute(
+    const pcl::PointCloud<pcl::PointXYZ>& cloud) const {
+  if (!cloud.isOrganized()) {
+    throw std::invalid_argument("NormalEstimator::compute needs an organized cloud");
+  }
+  pcl::PointCloud<pcl::PointNormal> out(cloud.width, cloud.height);
+  out.header = cloud.header;
+  out.is_dense = false;
+  if (cloud.empty())
+    return out;
+
+  pcl::PointCloud<pcl::Normal> normals;
+  // PCL's estimator needs at least a few rows and columns for its smoothing window.
+  if (cloud.width > 2 && cloud.height > 2) {
+    Estimator estimator;
+    estimator.setNormalEstimationMethod(methodFromName(params_.method));
+    estimator.setMaxDepthChangeFactor(static_cast<float>(params_.max_depth_change_factor));
+    estimator.setNormalSmoothingSize(static_cast<float>(params_.normal_smoothing_size));
+    estimator.setDepthDependentSmoothing(params_.depth_dependent_smoothing);
+    estimator.setViewPoint(0.f, 0.f, 0.f);
+    // The estimator keeps a shared pointer; wrap without copying (the cloud outlives the call).
+    estimator.setInputCloud(pcl::PointCloud<pcl::PointXYZ>::ConstPtr(
+        &cloud, [](const pcl::PointCloud<pcl::PointXYZ>*) {}));
+    estimator.compute(normals);
+  }
+
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    pcl::PointNormal& p = out[i];
+    p.x = cloud[i].x;
+    p.y = cloud[i].y;
+    p.z = cloud[i].z;
+    const bool has_normal = normals.size() == cloud.size() && std::isfinite(cloud[i].z) &&
+                            std::isfinite(normals[i].normal_x);
+    if (has_normal) {
+      p.normal_x = normals[i].normal_x;
+      p.normal_y = normals[i].normal_y;
+      p.normal_z = normals[i].normal_z;
+      p.curvature = normals[i].curvature;
+    } else {
+      p.normal_x = p.normal_y = p.normal_z = p.curvature = nan;
+    }
+  }
+  return out;
+}
+
+}  // namespace quadric_slam
