@@ -1,0 +1,36 @@
+// The map schema shared by the generator's truth (quadrics_gt.yaml), the mapper's saved map and the
+// evaluator (README, "Map files"). Plain data: no geometry is computed here.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace quadric_slam {
+
+struct MapFileQuadric {
+  int id = 0;
+  std::string quadric_class;  // plane | sphere | cylinder | cone | ellipsoid | general
+  int observations = 0;
+  Eigen::Isometry3d T_map_quadric = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();  // diagonal of S (1/m)
+  // Human-readable shape, keyed as in the schema: plane normal (3) + offset (1); sphere center (3)
+  // + radius (1); cylinder point (3) + axis (3) + radius (1); cone apex (3) + axis (3) +
+  // half_angle (1, rad). Scalars are vectors of length 1.
+  std::map<std::string, std::vector<double>> shape;
+};
+
+struct MapFile {
+  std::string frame_id = "map";
+  std::vector<MapFileQuadric> quadrics;
+};
+
+// Throws std::runtime_error naming the file and the problem (missing key, wrong length, bad YAML).
+MapFile readMapYaml(const std::string& path);
+MapFile parseMapYaml(const std::string& text);
+// Writes the schema; throws std::runtime_error when the file cannot be written.
+void writeMapYaml(const MapFile& map, const std::string& path);
+std::string mapYamlString(const MapFile& map);
+
+}  // namespace quadric_slam
