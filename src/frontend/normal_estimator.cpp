@@ -2,6 +2,8 @@
 
 #include <pcl/features/integral_image_normal.h>
 
+#include "quadric_slam/frontend/box_gradient_normals.h"
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -10,6 +12,8 @@ namespace quadric_slam {
 namespace {
 
 using Estimator = pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal>;
+
+constexpr const char* kOwnMethod = "box_gradient";
 
 Estimator::NormalEstimationMethod methodFromName(const std::string& name) {
   if (name == "average_3d_gradient")
@@ -21,7 +25,7 @@ Estimator::NormalEstimationMethod methodFromName(const std::string& name) {
   if (name == "simple_3d_gradient")
     return Estimator::SIMPLE_3D_GRADIENT;
   throw std::invalid_argument(
-      "method must be one of average_3d_gradient, covariance_matrix, "
+      "method must be one of box_gradient, average_3d_gradient, covariance_matrix, "
       "average_depth_change, simple_3d_gradient; got '" +
       name + "'");
 }
@@ -29,7 +33,8 @@ Estimator::NormalEstimationMethod methodFromName(const std::string& name) {
 }  // namespace
 
 void NormalEstimator::Params::validate() const {
-  methodFromName(method);
+  if (method != kOwnMethod)
+    methodFromName(method);
   if (!(max_depth_change_factor > 0.0 && max_depth_change_factor <= 1.0)) {
     throw std::invalid_argument("max_depth_change_factor must be in (0, 1], got " +
                                 std::to_string(max_depth_change_factor));
@@ -37,6 +42,9 @@ void NormalEstimator::Params::validate() const {
   if (!(normal_smoothing_size >= 1.0 && normal_smoothing_size <= 100.0)) {
     throw std::invalid_argument("normal_smoothing_size must be in [1, 100] pixels, got " +
                                 std::to_string(normal_smoothing_size));
+  }
+  if (threads < 1 || threads > 64) {
+    throw std::invalid_argument("threads must be in [1, 64], got " + std::to_string(threads));
   }
 }
 
@@ -54,6 +62,20 @@ pcl::PointCloud<pcl::PointNormal> NormalEstimator::compute(
   out.is_dense = false;
   if (cloud.empty())
     return out;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    out[i].x = cloud[i].x;
+    out[i].y = cloud[i].y;
+    out[i].z = cloud[i].z;
+  }
+  if (params_.method == kOwnMethod) {
+    BoxGradientSettings settings;
+    settings.max_half_window = static_cast<int>(params_.normal_smoothing_size);
+    settings.max_depth_change_factor = params_.max_depth_change_factor;
+    settings.depth_dependent_smoothing = params_.depth_dependent_smoothing;
+    settings.threads = params_.threads;
+    computeBoxGradientNormals(cloud, settings, out);
+    return out;
+  }
 
   pcl::PointCloud<pcl::Normal> normals;
   // PCL's estimator needs at least a few rows and columns for its smoothing window.
@@ -73,9 +95,6 @@ pcl::PointCloud<pcl::PointNormal> NormalEstimator::compute(
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     pcl::PointNormal& p = out[i];
-    p.x = cloud[i].x;
-    p.y = cloud[i].y;
-    p.z = cloud[i].z;
     const bool has_normal = normals.size() == cloud.size() && std::isfinite(cloud[i].z) &&
                             std::isfinite(normals[i].normal_x);
     if (has_normal) {

@@ -1,0 +1,112 @@
+// Benchmark of the normal-estimation stage (back-projection + PCL integral-image normals) on a real
+// 640x480 TUM depth frame: median and p95 over N runs per method.
+//
+//   bench_normals [--runs N] [--depth PNG] [--method NAME|all] [--smoothing PIXELS]
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/frontend/normal_estimator.h"
+
+namespace qs = quadric_slam;
+
+namespace {
+
+double percentile(std::vector<double> values, double q) {
+  std::sort(values.begin(), values.end());
+  const std::size_t index =
+      std::min(values.size() - 1, static_cast<std::size_t>(q * values.size()));
+  return values[index];
+}
+
+int usage() {
+  std::fprintf(stderr,
+               "usage: bench_normals [--runs N] [--depth PNG] [--method NAME|all] "
+               "[--smoothing PIXELS]\n");
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int runs = 200;
+  std::string depth_file = std::string(QUADRIC_SLAM_SHARED_DATA_DIR) +
+                           "/tum_frames/fr3_long_office_household/1341847980.723020.png";
+  std::string method = "all";
+  double smoothing = qs::NormalEstimator::Params().normal_smoothing_size;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (i + 1 >= argc)
+      return usage();
+    if (arg == "--runs") {
+      runs = std::atoi(argv[++i]);
+    } else if (arg == "--depth") {
+      depth_file = argv[++i];
+    } else if (arg == "--method") {
+      method = argv[++i];
+    } else if (arg == "--smoothing") {
+      smoothing = std::atof(argv[++i]);
+    } else {
+      return usage();
+    }
+  }
+  const cv::Mat raw = cv::imread(depth_file, cv::IMREAD_ANYDEPTH);
+  if (raw.empty() || raw.type() != CV_16UC1 || runs < 1) {
+    std::fprintf(stderr, "bench_normals: cannot read a 16-bit depth PNG from %s\n",
+                 depth_file.c_str());
+    return 1;
+  }
+  qs::CameraIntrinsics intrinsics;  // Freiburg3, as in shared/data/README.md
+  intrinsics.fx = 535.4;
+  intrinsics.fy = 539.2;
+  intrinsics.cx = 320.1;
+  intrinsics.cy = 247.6;
+  intrinsics.width = raw.cols;
+  intrinsics.height = raw.rows;
+  qs::DepthImageView<std::uint16_t> view;
+  view.data = raw.data;
+  view.width = raw.cols;
+  view.height = raw.rows;
+  view.row_step_bytes = raw.step;
+  view.metres_per_unit = 1.0 / 5000.0;
+
+  std::vector<std::string> methods = {method};
+  if (method == "all") {
+    methods = {"box_gradient", "average_3d_gradient", "covariance_matrix", "average_depth_change",
+               "simple_3d_gradient"};
+  }
+  std::printf("frame %dx%d from %s, %d runs per method\n", raw.cols, raw.rows, depth_file.c_str(),
+              runs);
+  std::printf("%-22s %10s %10s %10s %10s\n", "method", "median_ms", "p95_ms", "backproj_ms",
+              "valid");
+  for (const std::string& name : methods) {
+    qs::NormalEstimator::Params params;
+    params.method = name;
+    params.normal_smoothing_size = smoothing;
+    const qs::NormalEstimator estimator(params);
+    std::vector<double> total_ms, back_projection_ms;
+    std::size_t valid = 0;
+    for (int run = 0; run < runs; ++run) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto cloud = qs::backProject(view, intrinsics, {});
+      const auto t1 = std::chrono::steady_clock::now();
+      const auto normals = estimator.compute(cloud);
+      const auto t2 = std::chrono::steady_clock::now();
+      back_projection_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      total_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t0).count());
+      if (run == 0) {
+        for (const auto& p : normals)
+          valid += std::isfinite(p.normal_x) ? 1 : 0;
+      }
+    }
+    std::printf("%-22s %10.2f %10.2f %10.2f %10zu\n", name.c_str(), percentile(total_ms, 0.5),
+                percentile(total_ms, 0.95), percentile(back_projection_ms, 0.5), valid);
+  }
+  return 0;
+}
