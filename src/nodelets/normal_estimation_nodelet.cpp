@@ -1,7 +1,8 @@
 // normal_estimation: depth image + camera_info -> organized PointCloud2 with xyz and normals.
 //
-// Subscribes  depth/image_raw (sensor_msgs/Image, 32FC1 metres or 16UC1 millimetres)
+// Subscribes  depth/image (sensor_msgs/Image, 32FC1 metres or 16UC1 millimetres)
 //             depth/camera_info (sensor_msgs/CameraInfo, the latest one is used)
+// Parameters  config/normal_estimation.yaml (every key documented there)
 // Publishes   points_normals (sensor_msgs/PointCloud2, organized, fields x y z normal_x normal_y
 //             normal_z curvature, NaN where there is no data, the depth image's stamp and frame)
 #include <nodelet/nodelet.h>
@@ -39,6 +40,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     ros_params::read(private_nh, "normal_smoothing_size", normal_params.normal_smoothing_size, log);
     ros_params::read(private_nh, "depth_dependent_smoothing",
                      normal_params.depth_dependent_smoothing, log);
+    ros_params::read(private_nh, "threads", normal_params.threads, log);
     int queue_size = 5;
     ros_params::read(private_nh, "queue_size", queue_size, log);
     try {
@@ -53,8 +55,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("points_normals", queue_size);
     info_sub_ =
         nh.subscribe("depth/camera_info", queue_size, &NormalEstimationNodelet::onCameraInfo, this);
-    depth_sub_ =
-        nh.subscribe("depth/image_raw", queue_size, &NormalEstimationNodelet::onDepth, this);
+    depth_sub_ = nh.subscribe("depth/image", queue_size, &NormalEstimationNodelet::onDepth, this);
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
