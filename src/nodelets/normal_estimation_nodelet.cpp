@@ -5,20 +5,23 @@
 // Parameters  config/normal_estimation.yaml (every key documented there)
 // Publishes   points_normals (sensor_msgs/PointCloud2, organized, fields x y z normal_x normal_y
 //             normal_z curvature, NaN where there is no data, the depth image's stamp and frame)
+//             /diagnostics (health: frames processed and dropped, last reason)
+// Bad input (no camera_info yet, unsupported encoding, size mismatch, malformed buffer) gets a
+// throttled error and the frame is dropped.
 #include <nodelet/nodelet.h>
 #include <pcl_conversions/pcl_conversions.h>
 #include <ros/ros.h>
-#include <sensor_msgs/CameraInfo.h>
-#include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
-#include <sensor_msgs/image_encodings.h>
 #include <pluginlib/class_list_macros.hpp>
 
+#include <chrono>
 #include <memory>
 #include <mutex>
 
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/ros/depth_image.h"
+#include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/params.h"
 
 namespace quadric_slam {
@@ -52,6 +55,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     }
     NODELET_INFO("normal_estimation parameters:%s", log.str().c_str());
 
+    diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, "quadric_slam: normal_estimation");
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("points_normals", queue_size);
     info_sub_ =
         nh.subscribe("depth/camera_info", queue_size, &NormalEstimationNodelet::onCameraInfo, this);
@@ -59,13 +63,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
-    CameraIntrinsics intrinsics;
-    intrinsics.fx = info->K[0];
-    intrinsics.fy = info->K[4];
-    intrinsics.cx = info->K[2];
-    intrinsics.cy = info->K[5];
-    intrinsics.width = static_cast<int>(info->width);
-    intrinsics.height = static_cast<int>(info->height);
+    const CameraIntrinsics intrinsics = intrinsicsFromCameraInfo(*info);
     const std::string problem = intrinsics.problem();
     if (!problem.empty()) {
       NODELET_ERROR_THROTTLE(5.0, "normal_estimation: ignoring camera_info: %s", problem.c_str());
@@ -77,85 +75,40 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
   }
 
   void onDepth(const sensor_msgs::ImageConstPtr& image) {
+    const auto start = std::chrono::steady_clock::now();
     CameraIntrinsics intrinsics;
     {
       std::lock_guard<std::mutex> lock(intrinsics_mutex_);
       if (!have_intrinsics_) {
-        NODELET_ERROR_THROTTLE(5.0,
-                               "normal_estimation: no valid camera_info received on %s yet; "
-                               "dropping depth frames",
-                               info_sub_.getTopic().c_str());
+        drop("no valid camera_info received on " + info_sub_.getTopic() + " yet");
         return;
       }
       intrinsics = intrinsics_;
     }
-    const std::string size_problem = imageSizeProblem(intrinsics, static_cast<int>(image->width),
-                                                      static_cast<int>(image->height));
-    if (!size_problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "normal_estimation: dropping frame: %s", size_problem.c_str());
-      return;
-    }
-
     pcl::PointCloud<pcl::PointXYZ> cloud;
-    namespace enc = sensor_msgs::image_encodings;
-    if (image->encoding == enc::TYPE_32FC1) {
-      if (!checkBuffer<float>(*image))
-        return;
-      cloud = backProject(view<float>(*image, 1.0), intrinsics, back_projection_);
-    } else if (image->encoding == enc::TYPE_16UC1 || image->encoding == enc::MONO16) {
-      if (!checkBuffer<std::uint16_t>(*image))
-        return;
-      cloud = backProject(view<std::uint16_t>(*image, 0.001), intrinsics, back_projection_);
-    } else {
-      NODELET_ERROR_THROTTLE(5.0,
-                             "normal_estimation: unsupported depth encoding '%s' (expected 32FC1 "
-                             "metres or 16UC1 millimetres); dropping frame",
-                             image->encoding.c_str());
+    const std::string problem = depthImageToCloud(*image, intrinsics, back_projection_, cloud);
+    if (!problem.empty()) {
+      drop(problem);
       return;
     }
-
     const pcl::PointCloud<pcl::PointNormal> with_normals = estimator_->compute(cloud);
     auto msg = boost::make_shared<sensor_msgs::PointCloud2>();
     pcl::toROSMsg(with_normals, *msg);
     msg->header = image->header;
     cloud_pub_.publish(msg);
+    diagnostics_->frameProcessed(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
   }
 
-  // The buffer must hold height rows of row_step bytes, each at least width pixels wide.
-  template <typename T>
-  bool checkBuffer(const sensor_msgs::Image& image) {
-    const std::size_t min_step = static_cast<std::size_t>(image.width) * sizeof(T);
-    if (image.step < min_step ||
-        image.data.size() < static_cast<std::size_t>(image.step) * image.height) {
-      NODELET_ERROR_THROTTLE(5.0,
-                             "normal_estimation: malformed %s image (%u x %u, step %u, %zu bytes); "
-                             "dropping frame",
-                             image.encoding.c_str(), image.width, image.height, image.step,
-                             image.data.size());
-      return false;
-    }
-    if (image.is_bigendian) {
-      NODELET_ERROR_THROTTLE(5.0,
-                             "normal_estimation: big-endian depth images are not supported; "
-                             "dropping frame");
-      return false;
-    }
-    return true;
-  }
-
-  template <typename T>
-  static DepthImageView<T> view(const sensor_msgs::Image& image, double metres_per_unit) {
-    DepthImageView<T> v;
-    v.data = image.data.data();
-    v.width = static_cast<int>(image.width);
-    v.height = static_cast<int>(image.height);
-    v.row_step_bytes = image.step;
-    v.metres_per_unit = metres_per_unit;
-    return v;
+  void drop(const std::string& reason) {
+    NODELET_ERROR_THROTTLE(5.0, "normal_estimation: dropping depth frame: %s", reason.c_str());
+    diagnostics_->frameDropped(reason);
   }
 
   BackProjectionParams back_projection_;
   std::unique_ptr<NormalEstimator> estimator_;
+  std::unique_ptr<NodeletDiagnostics> diagnostics_;
   std::mutex intrinsics_mutex_;
   CameraIntrinsics intrinsics_;
   bool have_intrinsics_ = false;

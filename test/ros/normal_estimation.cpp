@@ -1,5 +1,6 @@
 // Checker for normal_estimation.test: publishes depth images of a known plane and bad input to the
 // nodelet, and checks the organized cloud it publishes.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <pcl_conversions/pcl_conversions.h>
 #include <ros/ros.h>
@@ -76,6 +77,7 @@ class NormalEstimationTest : public ::testing::Test {
     image_pub_ = nh.advertise<sensor_msgs::Image>("depth/image", 5);
     info_pub_ = nh.advertise<sensor_msgs::CameraInfo>("depth/camera_info", 5, true);
     cloud_sub_ = nh.subscribe("points_normals", 5, &NormalEstimationTest::onCloud, this);
+    diagnostics_sub_ = nh.subscribe("/diagnostics", 50, &NormalEstimationTest::onDiagnostics, this);
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
     while ((image_pub_.getNumSubscribers() == 0 || info_pub_.getNumSubscribers() == 0 ||
             cloud_sub_.getNumPublishers() == 0) &&
@@ -87,6 +89,19 @@ class NormalEstimationTest : public ::testing::Test {
   }
 
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& cloud) { clouds_.push_back(cloud); }
+
+  void onDiagnostics(const diagnostic_msgs::DiagnosticArrayConstPtr& array) {
+    for (const auto& status : array->status) {
+      if (status.name != "quadric_slam: normal_estimation")
+        continue;
+      for (const auto& kv : status.values) {
+        if (kv.key == "frames dropped")
+          frames_dropped_ = std::stoul(kv.value);
+        if (kv.key == "frames processed")
+          frames_processed_ = std::stoul(kv.value);
+      }
+    }
+  }
 
   // Publishes the image and waits for the cloud stamped like it; null when none comes in time.
   sensor_msgs::PointCloud2ConstPtr publishAndWait(const sensor_msgs::Image& image,
@@ -141,8 +156,9 @@ class NormalEstimationTest : public ::testing::Test {
   }
 
   ros::Publisher image_pub_, info_pub_;
-  ros::Subscriber cloud_sub_;
+  ros::Subscriber cloud_sub_, diagnostics_sub_;
   std::vector<sensor_msgs::PointCloud2ConstPtr> clouds_;
+  unsigned long frames_dropped_ = 0, frames_processed_ = 0;
 };
 
 TEST_F(NormalEstimationTest, PlaneInBothEncodingsAndBadInput) {
@@ -180,6 +196,15 @@ TEST_F(NormalEstimationTest, PlaneInBothEncodingsAndBadInput) {
   // 5. The nodelet is still alive and well after bad input.
   cloud = publishAndWait(planeImage(enc::TYPE_32FC1, kWidth, kHeight, 7.0), 20.0);
   ASSERT_NE(cloud, nullptr) << "no cloud after bad input";
+
+  // 6. /diagnostics counts what happened: 4 frames dropped, 3 processed.
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(5.0);
+  while (frames_processed_ < 3 && ros::WallTime::now() < deadline) {
+    ros::WallDuration(0.05).sleep();
+    ros::spinOnce();
+  }
+  EXPECT_EQ(frames_dropped_, 4u);
+  EXPECT_EQ(frames_processed_, 3u);
 }
 
 }  // namespace

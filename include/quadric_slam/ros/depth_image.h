@@ -1,0 +1,29 @@
+// sensor_msgs/Image and CameraInfo into the core's depth types: both depth encodings (32FC1 metres,
+// 16UC1 millimetres) go through one templated back-projection.
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+
+#include <string>
+
+#include "quadric_slam/frontend/frame.h"
+
+namespace quadric_slam {
+
+// Intrinsics from camera_info's K and size (check .problem() before use).
+CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info);
+
+// Empty when the image is a depth image this package reads and its buffer is consistent, else the
+// reason (unsupported encoding, big-endian data, short buffer).
+std::string depthImageProblem(const sensor_msgs::Image& image);
+
+// Back-projects a depth image into an organized cloud. Returns the problem that prevents it
+// (depthImageProblem(), or the image size not matching the intrinsics); cloud is untouched then.
+std::string depthImageToCloud(const sensor_msgs::Image& image, const CameraIntrinsics& intrinsics,
+                              const BackProjectionParams& params,
+                              pcl::PointCloud<pcl::PointXYZ>& cloud);
+
+}  // namespace quadric_slam
