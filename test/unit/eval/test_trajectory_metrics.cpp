@@ -155,3 +155,27 @@ TEST(TrajectoryMetrics, ReproducesTumEvaluateAteOnRealTrajectories) {
     EXPECT_LT(rpe.translation.rmse, 0.5) << r.sequence;  // drift of a working SLAM system, m/s
   }
 }
+
+TEST(TrajectoryMetrics, RpeMatchesAPlainTranscriptionOfEvaluateRpe) {
+  const std::string dir = std::string(QUADRIC_SLAM_SHARED_DATA_DIR) + "/tum_groundtruth/";
+  if (!std::ifstream(dir + "rgbd_dataset_freiburg1_xyz-groundtruth.txt")) {
+    GTEST_SKIP() << "TUM ground truth not found in " << dir;
+  }
+  // Values from a line-by-line pure-Python transcription of TUM's evaluate_rpe.py with
+  // --fixed_delta --delta 1 --delta_unit s (pairs, translational_error.rmse printed with %f).
+  struct Reference {
+    const char* sequence;
+    std::size_t pairs;
+    double rmse;
+  };
+  const Reference references[] = {{"freiburg1_xyz", 753, 0.021217},
+                                  {"freiburg1_desk", 542, 0.033252}};
+  for (const Reference& r : references) {
+    const Trajectory gt =
+        quadric_slam::readTumTrajectory(dir + "rgbd_dataset_" + r.sequence + "-groundtruth.txt");
+    const Trajectory est = quadric_slam::readTumTrajectory(dir + r.sequence + "-rgbdslam.txt");
+    const auto rpe = RelativePoseError().evaluate(gt, est);
+    EXPECT_EQ(rpe.pairs(), r.pairs) << r.sequence;
+    EXPECT_NEAR(rpe.translation.rmse, r.rmse, 5e-7 + 1e-12) << r.sequence;
+  }
+}
