@@ -1,0 +1,105 @@
+// Map evaluation against a truth map (the generator's quadrics_gt.yaml), from the human-readable
+// `shape` keys of the map schema (io/map_yaml.h):
+//   plane normal + offset, sphere center + radius, cylinder point + axis + radius,
+//   cone apex + axis + half_angle.
+// The estimated map is first moved into the truth frame (T_truth_estimate, e.g. the ATE alignment
+// of the estimated trajectory onto the ground truth). Each estimate is assigned to the nearest true
+// primitive of its class whose every shape error is within that class's gate; per true primitive
+// the nearest assigned estimate is its match, further assigned estimates are duplicates, and a true
+// primitive without any is a miss. Estimates assigned to no truth are counted as unmatched.
+// Classes other than plane, sphere, cylinder and cone are not evaluated (counted as skipped).
+#pragma once
+
+#include <Eigen/Geometry>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "quadric_slam/io/map_yaml.h"
+
+namespace quadric_slam {
+
+// One named shape error of a matched pair, in the unit its name ends with (_deg or _m).
+struct ShapeError {
+  std::string name;  // e.g. "normal_angle_deg", "offset_m"
+  double value = 0;
+};
+
+// Shape errors of an estimate against a truth of the same class (both in the truth frame), in a
+// fixed order per class:
+//   plane:    normal_angle_deg (unsigned normal), offset_m (|d_t - d_e| after orienting n_e like
+//   n_t) sphere:   center_m, radius_m cylinder: axis_angle_deg (unsigned axis), axis_distance_m
+//   (truth point to estimated axis line),
+//             radius_m
+//   cone:     apex_m, axis_angle_deg (unsigned: the quadric is a double cone), half_angle_deg
+// Throws std::runtime_error naming the quadric id and key when a shape key is missing or malformed,
+// std::invalid_argument when the classes differ or are not evaluated.
+std::vector<ShapeError> shapeErrors(const MapFileQuadric& truth, const MapFileQuadric& estimate);
+
+// The quadric's shape keys moved by T_b_a (from frame a into frame b); pose moved too.
+MapFileQuadric transformQuadric(const MapFileQuadric& quadric, const Eigen::Isometry3d& T_b_a);
+
+// True for the classes map evaluation understands (plane, sphere, cylinder, cone).
+bool isEvaluatedClass(const std::string& quadric_class);
+
+struct TruthResult {
+  int truth_id = 0;
+  std::string quadric_class;
+  bool matched = false;
+  int estimate_id = -1;            // the match, when matched
+  double distance = 0;             // normalised shape distance of the match (see Params)
+  std::vector<ShapeError> errors;  // of the match, when matched
+  std::vector<int> duplicate_ids;  // further estimates assigned to this truth
+};
+
+struct ClassSummary {
+  int truths = 0, matched = 0, misses = 0, duplicates = 0, unmatched_estimates = 0;
+  std::vector<ShapeError> mean_errors;  // mean over matched truths, same names/order as errors
+};
+
+struct MapReport {
+  std::vector<TruthResult> truths;              // in truth-file order (evaluated classes only)
+  std::map<std::string, ClassSummary> classes;  // keyed by class name
+  int matched = 0, misses = 0, duplicates = 0, unmatched_estimates = 0;
+  int skipped_truths = 0, skipped_estimates = 0;  // classes not evaluated
+};
+
+class MapEvaluator {
+ public:
+  // Gates: an estimate can match a truth only when every shape error is within its gate. The
+  // normalised distance used to pick the nearest is sqrt(sum (error / gate)^2).
+  struct Params {
+    double plane_angle_gate_deg = 15.0;
+    double plane_offset_gate_m = 0.15;
+    double sphere_center_gate_m = 0.2;
+    double sphere_radius_gate_m = 0.1;
+    double cylinder_angle_gate_deg = 15.0;
+    double cylinder_axis_distance_gate_m = 0.15;
+    double cylinder_radius_gate_m = 0.1;
+    double cone_apex_gate_m = 0.2;
+    double cone_angle_gate_deg = 15.0;
+    double cone_half_angle_gate_deg = 10.0;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range (0, inf).
+    void validate() const;
+  };
+
+  MapEvaluator() : MapEvaluator(Params{}) {}
+  explicit MapEvaluator(const Params& params);
+
+  // Gates of a class, in the order of shapeErrors().
+  std::vector<double> gates(const std::string& quadric_class) const;
+
+  MapReport evaluate(const MapFile& truth, const MapFile& estimate,
+                     const Eigen::Isometry3d& T_truth_estimate) const;
+
+ private:
+  Params params_;
+};
+
+// Human-readable report: one line per true primitive, one per class, and a final summary line
+// "map_summary matched N misses N duplicates N unmatched_estimates N".
+std::string formatMapReport(const MapReport& report);
+
+}  // namespace quadric_slam

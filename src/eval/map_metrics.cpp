@@ -1,0 +1,312 @@
+#include "quadric_slam/eval/map_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+namespace quadric_slam {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+const std::vector<double>& shapeValues(const MapFileQuadric& q, const std::string& key,
+                                       std::size_t size) {
+  const auto it = q.shape.find(key);
+  if (it == q.shape.end()) {
+    throw std::runtime_error("quadric " + std::to_string(q.id) + " (" + q.quadric_class +
+                             "): missing shape key '" + key + "'");
+  }
+  if (it->second.size() != size) {
+    throw std::runtime_error("quadric " + std::to_string(q.id) + " (" + q.quadric_class +
+                             "): shape key '" + key + "' needs " + std::to_string(size) +
+                             " values, got " + std::to_string(it->second.size()));
+  }
+  for (double v : it->second) {
+    if (!std::isfinite(v)) {
+      throw std::runtime_error("quadric " + std::to_string(q.id) + ": shape key '" + key +
+                               "' is not finite");
+    }
+  }
+  return it->second;
+}
+
+Eigen::Vector3d point(const MapFileQuadric& q, const std::string& key) {
+  const std::vector<double>& v = shapeValues(q, key, 3);
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
+
+Eigen::Vector3d direction(const MapFileQuadric& q, const std::string& key) {
+  const Eigen::Vector3d d = point(q, key);
+  if (!(d.norm() > 1e-12)) {
+    throw std::runtime_error("quadric " + std::to_string(q.id) + ": shape key '" + key +
+                             "' is a zero vector");
+  }
+  return d.normalized();
+}
+
+double scalar(const MapFileQuadric& q, const std::string& key) {
+  return shapeValues(q, key, 1)[0];
+}
+
+void setPoint(MapFileQuadric& q, const std::string& key, const Eigen::Vector3d& p) {
+  q.shape[key] = {p.x(), p.y(), p.z()};
+}
+
+// Angle between two lines (unsigned directions), degrees; atan2 keeps small angles accurate.
+double lineAngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), std::abs(a.dot(b))) * kRadToDeg;
+}
+
+double distanceToLine(const Eigen::Vector3d& p, const Eigen::Vector3d& line_point,
+                      const Eigen::Vector3d& unit_direction) {
+  const Eigen::Vector3d v = p - line_point;
+  return (v - v.dot(unit_direction) * unit_direction).norm();
+}
+
+void requirePositive(double value, const char* name) {
+  if (!(value > 0.0) || !std::isfinite(value)) {
+    throw std::invalid_argument(std::string(name) + " must be in (0, inf), got " +
+                                std::to_string(value));
+  }
+}
+
+}  // namespace
+
+bool isEvaluatedClass(const std::string& quadric_class) {
+  return quadric_class == "plane" || quadric_class == "sphere" || quadric_class == "cylinder" ||
+         quadric_class == "cone";
+}
+
+std::vector<ShapeError> shapeErrors(const MapFileQuadric& truth, const MapFileQuadric& estimate) {
+  if (truth.quadric_class != estimate.quadric_class || !isEvaluatedClass(truth.quadric_class)) {
+    throw std::invalid_argument(
+        "shapeErrors compares two plane/sphere/cylinder/cone quadrics of "
+        "one class, got " +
+        truth.quadric_class + " and " + estimate.quadric_class);
+  }
+  const std::string& c = truth.quadric_class;
+  if (c == "plane") {
+    const Eigen::Vector3d n_t = direction(truth, "normal");
+    Eigen::Vector3d n_e = direction(estimate, "normal");
+    double d_e = scalar(estimate, "offset") / point(estimate, "normal").norm();
+    const double d_t = scalar(truth, "offset") / point(truth, "normal").norm();
+    if (n_t.dot(n_e) < 0) {  // (n, d) and (-n, -d) are the same plane
+      n_e = -n_e;
+      d_e = -d_e;
+    }
+    return {{"normal_angle_deg", lineAngleDeg(n_t, n_e)}, {"offset_m", std::abs(d_t - d_e)}};
+  }
+  if (c == "sphere") {
+    return {{"center_m", (point(truth, "center") - point(estimate, "center")).norm()},
+            {"radius_m", std::abs(scalar(truth, "radius") - scalar(estimate, "radius"))}};
+  }
+  if (c == "cylinder") {
+    const Eigen::Vector3d a_e = direction(estimate, "axis");
+    return {
+        {"axis_angle_deg", lineAngleDeg(direction(truth, "axis"), a_e)},
+        {"axis_distance_m", distanceToLine(point(truth, "point"), point(estimate, "point"), a_e)},
+        {"radius_m", std::abs(scalar(truth, "radius") - scalar(estimate, "radius"))}};
+  }
+  return {{"apex_m", (point(truth, "apex") - point(estimate, "apex")).norm()},
+          {"axis_angle_deg", lineAngleDeg(direction(truth, "axis"), direction(estimate, "axis"))},
+          {"half_angle_deg",
+           std::abs(scalar(truth, "half_angle") - scalar(estimate, "half_angle")) * kRadToDeg}};
+}
+
+MapFileQuadric transformQuadric(const MapFileQuadric& quadric, const Eigen::Isometry3d& T_b_a) {
+  MapFileQuadric q = quadric;
+  q.T_map_quadric = T_b_a * quadric.T_map_quadric;
+  const Eigen::Matrix3d R = T_b_a.linear();
+  const std::string& c = quadric.quadric_class;
+  if (c == "plane") {
+    // n.p = d in a  =>  (R n).(R p + t) = d + (R n).t in b.
+    const Eigen::Vector3d n = R * point(quadric, "normal");
+    setPoint(q, "normal", n);
+    q.shape["offset"] = {scalar(quadric, "offset") + n.dot(T_b_a.translation())};
+  } else if (c == "sphere") {
+    setPoint(q, "center", T_b_a * point(quadric, "center"));
+  } else if (c == "cylinder") {
+    setPoint(q, "point", T_b_a * point(quadric, "point"));
+    setPoint(q, "axis", R * point(quadric, "axis"));
+  } else if (c == "cone") {
+    setPoint(q, "apex", T_b_a * point(quadric, "apex"));
+    setPoint(q, "axis", R * point(quadric, "axis"));
+  }
+  return q;
+}
+
+void MapEvaluator::Params::validate() const {
+  requirePositive(plane_angle_gate_deg, "plane_angle_gate_deg");
+  requirePositive(plane_offset_gate_m, "plane_offset_gate_m");
+  requirePositive(sphere_center_gate_m, "sphere_center_gate_m");
+  requirePositive(sphere_radius_gate_m, "sphere_radius_gate_m");
+  requirePositive(cylinder_angle_gate_deg, "cylinder_angle_gate_deg");
+  requirePositive(cylinder_axis_distance_gate_m, "cylinder_axis_distance_gate_m");
+  requirePositive(cylinder_radius_gate_m, "cylinder_radius_gate_m");
+  requirePositive(cone_apex_gate_m, "cone_apex_gate_m");
+  requirePositive(cone_angle_gate_deg, "cone_angle_gate_deg");
+  requirePositive(cone_half_angle_gate_deg, "cone_half_angle_gate_deg");
+}
+
+MapEvaluator::MapEvaluator(const Params& params) : params_(params) {
+  params_.validate();
+}
+
+std::vector<double> MapEvaluator::gates(const std::string& quadric_class) const {
+  const Params& p = params_;
+  if (quadric_class == "plane")
+    return {p.plane_angle_gate_deg, p.plane_offset_gate_m};
+  if (quadric_class == "sphere")
+    return {p.sphere_center_gate_m, p.sphere_radius_gate_m};
+  if (quadric_class == "cylinder") {
+    return {p.cylinder_angle_gate_deg, p.cylinder_axis_distance_gate_m, p.cylinder_radius_gate_m};
+  }
+  if (quadric_class == "cone") {
+    return {p.cone_apex_gate_m, p.cone_angle_gate_deg, p.cone_half_angle_gate_deg};
+  }
+  throw std::invalid_argument("no gates for class '" + quadric_class + "'");
+}
+
+MapReport MapEvaluator::evaluate(const MapFile& truth, const MapFile& estimate,
+                                 const Eigen::Isometry3d& T_truth_estimate) const {
+  MapReport report;
+  std::vector<const MapFileQuadric*> truths;
+  for (const MapFileQuadric& q : truth.quadrics) {
+    if (!isEvaluatedClass(q.quadric_class)) {
+      ++report.skipped_truths;
+      continue;
+    }
+    truths.push_back(&q);
+    TruthResult r;
+    r.truth_id = q.id;
+    r.quadric_class = q.quadric_class;
+    report.truths.push_back(r);
+    ++report.classes[q.quadric_class].truths;
+  }
+
+  // Each estimate goes to the nearest gated truth of its class.
+  struct Assignment {
+    double distance;
+    int estimate_id;
+    std::vector<ShapeError> errors;
+  };
+  std::vector<std::vector<Assignment>> assigned(truths.size());
+  for (const MapFileQuadric& raw : estimate.quadrics) {
+    if (!isEvaluatedClass(raw.quadric_class)) {
+      ++report.skipped_estimates;
+      continue;
+    }
+    const MapFileQuadric e = transformQuadric(raw, T_truth_estimate);
+    const std::vector<double> gate = gates(e.quadric_class);
+    int best = -1;
+    Assignment best_assignment{0, e.id, {}};
+    for (std::size_t k = 0; k < truths.size(); ++k) {
+      if (truths[k]->quadric_class != e.quadric_class)
+        continue;
+      std::vector<ShapeError> errors = shapeErrors(*truths[k], e);
+      bool inside = true;
+      double sum = 0;
+      for (std::size_t i = 0; i < errors.size(); ++i) {
+        inside = inside && errors[i].value <= gate[i];
+        sum += (errors[i].value / gate[i]) * (errors[i].value / gate[i]);
+      }
+      const double distance = std::sqrt(sum);
+      if (inside && (best < 0 || distance < best_assignment.distance)) {
+        best = static_cast<int>(k);
+        best_assignment = {distance, e.id, std::move(errors)};
+      }
+    }
+    if (best < 0) {
+      ++report.unmatched_estimates;
+      ++report.classes[e.quadric_class].unmatched_estimates;
+    } else {
+      assigned[static_cast<std::size_t>(best)].push_back(std::move(best_assignment));
+    }
+  }
+
+  std::map<std::string, std::vector<double>> error_sums;
+  for (std::size_t k = 0; k < truths.size(); ++k) {
+    TruthResult& r = report.truths[k];
+    ClassSummary& summary = report.classes[r.quadric_class];
+    std::vector<Assignment>& list = assigned[k];
+    if (list.empty()) {
+      ++summary.misses;
+      ++report.misses;
+      continue;
+    }
+    std::stable_sort(list.begin(), list.end(), [](const Assignment& a, const Assignment& b) {
+      return a.distance < b.distance;
+    });
+    r.matched = true;
+    r.estimate_id = list[0].estimate_id;
+    r.distance = list[0].distance;
+    r.errors = list[0].errors;
+    for (std::size_t i = 1; i < list.size(); ++i)
+      r.duplicate_ids.push_back(list[i].estimate_id);
+    ++summary.matched;
+    ++report.matched;
+    summary.duplicates += static_cast<int>(r.duplicate_ids.size());
+    report.duplicates += static_cast<int>(r.duplicate_ids.size());
+    std::vector<double>& sums = error_sums[r.quadric_class];
+    sums.resize(r.errors.size(), 0.0);
+    if (summary.mean_errors.empty()) {
+      for (const ShapeError& error : r.errors)
+        summary.mean_errors.push_back({error.name, 0.0});
+    }
+    for (std::size_t i = 0; i < r.errors.size(); ++i)
+      sums[i] += r.errors[i].value;
+  }
+  for (auto& [name, summary] : report.classes) {
+    for (std::size_t i = 0; i < summary.mean_errors.size(); ++i) {
+      summary.mean_errors[i].value = error_sums[name][i] / summary.matched;
+    }
+  }
+  return report;
+}
+
+std::string formatMapReport(const MapReport& report) {
+  std::ostringstream out;
+  char number[64];
+  auto fmt = [&](double v) {
+    std::snprintf(number, sizeof(number), "%.6f", v);
+    return std::string(number);
+  };
+  for (const TruthResult& r : report.truths) {
+    out << "truth " << r.truth_id << " " << r.quadric_class;
+    if (!r.matched) {
+      out << " missed\n";
+      continue;
+    }
+    out << " matched estimate " << r.estimate_id;
+    for (const ShapeError& e : r.errors)
+      out << " " << e.name << " " << fmt(e.value);
+    out << " distance " << fmt(r.distance);
+    if (!r.duplicate_ids.empty()) {
+      out << " duplicates";
+      for (std::size_t i = 0; i < r.duplicate_ids.size(); ++i) {
+        out << (i == 0 ? " " : ",") << r.duplicate_ids[i];
+      }
+    }
+    out << "\n";
+  }
+  for (const auto& [name, s] : report.classes) {
+    out << "class " << name << " truths " << s.truths << " matched " << s.matched << " misses "
+        << s.misses << " duplicates " << s.duplicates << " unmatched_estimates "
+        << s.unmatched_estimates;
+    for (const ShapeError& e : s.mean_errors)
+      out << " mean_" << e.name << " " << fmt(e.value);
+    out << "\n";
+  }
+  out << "map_summary matched " << report.matched << " misses " << report.misses << " duplicates "
+      << report.duplicates << " unmatched_estimates " << report.unmatched_estimates;
+  if (report.skipped_truths + report.skipped_estimates > 0) {
+    out << " skipped_truths " << report.skipped_truths << " skipped_estimates "
+        << report.skipped_estimates;
+  }
+  out << "\n";
+  return out.str();
+}
+
+}  // namespace quadric_slam

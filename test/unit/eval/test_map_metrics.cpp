@@ -1,0 +1,192 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "quadric_slam/eval/map_metrics.h"
+
+using quadric_slam::MapEvaluator;
+using quadric_slam::MapFile;
+using quadric_slam::MapFileQuadric;
+using quadric_slam::MapReport;
+using quadric_slam::TruthResult;
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+MapFileQuadric quadric(int id, const std::string& c,
+                       std::map<std::string, std::vector<double>> shape) {
+  MapFileQuadric q;
+  q.id = id;
+  q.quadric_class = c;
+  q.shape = std::move(shape);
+  return q;
+}
+
+std::vector<double> vec(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+double errorNamed(const TruthResult& r, const std::string& name) {
+  for (const auto& e : r.errors) {
+    if (e.name == name)
+      return e.value;
+  }
+  ADD_FAILURE() << "no error named " << name;
+  return NAN;
+}
+
+Eigen::Isometry3d someTransform() {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() =
+      Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, 0.5, -1).normalized()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(-3, 0.7, 1.9);
+  return T;
+}
+
+}  // namespace
+
+TEST(MapMetrics, TransformMovesShapesConsistently) {
+  const Eigen::Isometry3d T = someTransform();
+  const Eigen::Vector3d n = Eigen::Vector3d(1, 2, 2) / 3.0;
+  const MapFileQuadric plane = quadric(1, "plane", {{"normal", vec(n)}, {"offset", {1.5}}});
+  const MapFileQuadric moved = quadric_slam::transformQuadric(plane, T);
+  // A point on the plane stays on the moved plane.
+  const Eigen::Vector3d p = 1.5 * n + Eigen::Vector3d(2, -1, 0);  // n.(2,-1,0) = 0
+  const auto& n2 = moved.shape.at("normal");
+  EXPECT_NEAR(Eigen::Vector3d(n2[0], n2[1], n2[2]).dot(T * p), moved.shape.at("offset")[0], 1e-12);
+  // Round trip through the inverse gives zero errors.
+  const MapFileQuadric cone =
+      quadric(2, "cone", {{"apex", {1, 2, 3}}, {"axis", {0, 0, -1}}, {"half_angle", {0.4}}});
+  const MapFileQuadric back =
+      quadric_slam::transformQuadric(quadric_slam::transformQuadric(cone, T), T.inverse());
+  for (const auto& e : quadric_slam::shapeErrors(cone, back))
+    EXPECT_NEAR(e.value, 0.0, 1e-9) << e.name;
+}
+
+TEST(MapMetrics, HandMadeMapsWithKnownErrors) {
+  MapFile truth;
+  truth.quadrics = {
+      quadric(1, "plane", {{"normal", {0, 0, 1}}, {"offset", {0.0}}}),
+      quadric(2, "plane", {{"normal", {1, 0, 0}}, {"offset", {2.0}}}),
+      quadric(3, "sphere", {{"center", {1, 1, 0.5}}, {"radius", {0.2}}}),
+      quadric(4, "cylinder", {{"point", {0, 1, 0.5}}, {"axis", {0, 0, 1}}, {"radius", {0.1}}}),
+      quadric(5, "cone", {{"apex", {2, 0, 1}}, {"axis", {0, 0, -1}}, {"half_angle", {0.5}}}),
+      quadric(6, "ellipsoid", {}),
+  };
+
+  // Estimates built in the truth frame with known errors, then expressed in the estimate frame.
+  const Eigen::Isometry3d T_truth_est = someTransform();
+  const Eigen::Vector3d tilted_floor =
+      Eigen::AngleAxisd(2.0 * kDeg, Eigen::Vector3d::UnitX()) * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d tilted_axis =
+      Eigen::AngleAxisd(3.0 * kDeg, Eigen::Vector3d::UnitX()) * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d cone_axis =
+      Eigen::AngleAxisd(4.0 * kDeg, Eigen::Vector3d::UnitY()) * -Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d wall_30 =
+      Eigen::AngleAxisd(30.0 * kDeg, Eigen::Vector3d::UnitZ()) * Eigen::Vector3d::UnitX();
+  MapFile in_truth_frame;
+  in_truth_frame.quadrics = {
+      // floor with the opposite sign convention: (-n, -d) is the same plane, offset 0.03 m
+      quadric(11, "plane", {{"normal", vec(-tilted_floor)}, {"offset", {-0.03}}}),
+      // duplicate of the sphere listed first, farther than the real match
+      quadric(12, "sphere", {{"center", {1.1, 1, 0.5}}, {"radius", {0.2}}}),
+      quadric(13, "sphere", {{"center", {1.03, 1.04, 0.5}}, {"radius", {0.21}}}),
+      // axis flipped and tilted 3 deg about x, point 2 cm off in x and slid 0.3 m along the axis
+      quadric(14, "cylinder",
+              {{"point", vec(Eigen::Vector3d(0.02, 1, 0.5) + 0.3 * tilted_axis)},
+               {"axis", vec(-tilted_axis)},
+               {"radius", {0.12}}}),
+      quadric(
+          15, "cone",
+          {{"apex", {2, 0.05, 1}}, {"axis", vec(cone_axis)}, {"half_angle", {0.5 + 2.0 * kDeg}}}),
+      quadric(16, "sphere", {{"center", {11, 1, 0.5}}, {"radius", {0.2}}}),  // nothing there
+      quadric(17, "plane", {{"normal", vec(wall_30)}, {"offset", {2.0}}}),   // 30 deg off the wall
+      quadric(18, "ellipsoid", {}),
+  };
+  MapFile estimate;
+  for (const auto& q : in_truth_frame.quadrics) {
+    estimate.quadrics.push_back(quadric_slam::transformQuadric(q, T_truth_est.inverse()));
+  }
+
+  const MapReport report = MapEvaluator().evaluate(truth, estimate, T_truth_est);
+  ASSERT_EQ(report.truths.size(), 5u);
+  EXPECT_EQ(report.matched, 4);
+  EXPECT_EQ(report.misses, 1);
+  EXPECT_EQ(report.duplicates, 1);
+  EXPECT_EQ(report.unmatched_estimates, 2);
+  EXPECT_EQ(report.skipped_truths, 1);
+  EXPECT_EQ(report.skipped_estimates, 1);
+
+  const TruthResult& floor = report.truths[0];
+  ASSERT_TRUE(floor.matched);
+  EXPECT_EQ(floor.estimate_id, 11);
+  EXPECT_NEAR(errorNamed(floor, "normal_angle_deg"), 2.0, 1e-9);
+  EXPECT_NEAR(errorNamed(floor, "offset_m"), 0.03, 1e-9);
+  EXPECT_FALSE(report.truths[1].matched);  // the wall: only a 30 deg-off plane near it
+
+  const TruthResult& sphere = report.truths[2];
+  ASSERT_TRUE(sphere.matched);
+  EXPECT_EQ(sphere.estimate_id, 13);
+  EXPECT_EQ(sphere.duplicate_ids, std::vector<int>{12});
+  EXPECT_NEAR(errorNamed(sphere, "center_m"), 0.05, 1e-9);
+  EXPECT_NEAR(errorNamed(sphere, "radius_m"), 0.01, 1e-9);
+
+  const TruthResult& cylinder = report.truths[3];
+  ASSERT_TRUE(cylinder.matched);
+  EXPECT_NEAR(errorNamed(cylinder, "axis_angle_deg"), 3.0, 1e-9);
+  EXPECT_NEAR(errorNamed(cylinder, "axis_distance_m"), 0.02, 1e-9);
+  EXPECT_NEAR(errorNamed(cylinder, "radius_m"), 0.02, 1e-9);
+
+  const TruthResult& cone = report.truths[4];
+  ASSERT_TRUE(cone.matched);
+  EXPECT_NEAR(errorNamed(cone, "apex_m"), 0.05, 1e-9);
+  EXPECT_NEAR(errorNamed(cone, "axis_angle_deg"), 4.0, 1e-9);
+  EXPECT_NEAR(errorNamed(cone, "half_angle_deg"), 2.0, 1e-9);
+
+  const auto& planes = report.classes.at("plane");
+  EXPECT_EQ(planes.truths, 2);
+  EXPECT_EQ(planes.matched, 1);
+  EXPECT_EQ(planes.misses, 1);
+  EXPECT_EQ(planes.unmatched_estimates, 1);
+  EXPECT_EQ(report.classes.at("sphere").duplicates, 1);
+  EXPECT_EQ(report.classes.at("sphere").unmatched_estimates, 1);
+
+  const std::string text = quadric_slam::formatMapReport(report);
+  EXPECT_NE(text.find("truth 2 plane missed\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("truth 3 sphere matched estimate 13 center_m 0.050000 radius_m 0.010000"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("map_summary matched 4 misses 1 duplicates 1 unmatched_estimates 2"),
+            std::string::npos)
+      << text;
+
+  // Without the alignment the estimate lies elsewhere: nothing matches.
+  const MapReport unaligned =
+      MapEvaluator().evaluate(truth, estimate, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(unaligned.matched, 0);
+  EXPECT_EQ(unaligned.misses, 5);
+}
+
+TEST(MapMetrics, BadInputNamesTheProblem) {
+  MapEvaluator::Params params;
+  params.sphere_radius_gate_m = 0.0;
+  try {
+    MapEvaluator evaluator(params);
+    FAIL() << "expected invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("sphere_radius_gate_m"), std::string::npos);
+  }
+  MapFile truth, estimate;
+  truth.quadrics = {quadric(7, "sphere", {{"center", {0, 0, 0}}, {"radius", {1}}})};
+  estimate.quadrics = {quadric(9, "sphere", {{"centre", {0, 0, 0}}, {"radius", {1}}})};
+  try {
+    MapEvaluator().evaluate(truth, estimate, Eigen::Isometry3d::Identity());
+    FAIL() << "expected runtime_error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("quadric 9"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'center'"), std::string::npos) << e.what();
+  }
+}
