@@ -1,5 +1,6 @@
 #include "quadric_slam/geometry/quadric_classes.h"
 
+#include <Eigen/LU>
 #include <array>
 #include <stdexcept>
 

@@ -110,19 +110,19 @@ Eigen::Matrix3d barfootQ(const Eigen::Vector3d& rho, const Eigen::Vector3d& phi)
   const double t = phi.norm();
   const Eigen::Matrix3d P = skew(phi);
   const Eigen::Matrix3d Rh = skew(rho);
-  double c1, c2, c5;  // (t - sin t)/t^3, (t^2/2 + cos t - 1)/t^4, (t - sin t - t^3/6)/t^5
+  // c1 = (t - sin t)/t^3, c2 = (t^2 + 2 cos t - 2)/(2 t^4), c3 = (2t - 3 sin t + t cos t)/(2 t^5)
+  double c1, c2, c3;
   if (t < kSmallAngle) {
     const double t2 = t * t;
     c1 = 1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0;
     c2 = 1.0 / 24.0 - t2 / 720.0 + t2 * t2 / 40320.0;
-    c5 = -1.0 / 120.0 + t2 / 5040.0 - t2 * t2 / 362880.0;
+    c3 = 1.0 / 120.0 - t2 / 2520.0 + t2 * t2 / 120960.0;
   } else {
     const double t2 = t * t, t3 = t2 * t;
     c1 = (t - std::sin(t)) / t3;
-    c2 = (0.5 * t2 + std::cos(t) - 1.0) / (t2 * t2);
-    c5 = (t - std::sin(t) - t3 / 6.0) / (t3 * t2);
+    c2 = (t2 + 2.0 * std::cos(t) - 2.0) / (2.0 * t2 * t2);
+    c3 = (2.0 * t - 3.0 * std::sin(t) + t * std::cos(t)) / (2.0 * t3 * t2);
   }
-  const double c3 = 0.5 * (c2 - 3.0 * c5);
   const Eigen::Matrix3d PR = P * Rh, RP = Rh * P, PRP = P * Rh * P;
   return 0.5 * Rh + c1 * (PR + RP + PRP) + c2 * (P * PR + RP * P - 3.0 * PRP) +
          c3 * (PRP * P + P * PRP);
