@@ -61,6 +61,39 @@ inline Quadric randomQuadric(QuadricClass c, std::mt19937& rng,
   return Quadric(c, T, s, general_signature);
 }
 
+// A random element of the class's symmetry group, including discrete flips (quadric frame).
+inline Eigen::Isometry3d randomSymmetry(QuadricClass c, std::mt19937& rng) {
+  const double angle = uniform(rng, -M_PI, M_PI);
+  const double slide = uniform(rng, -2, 2), slide2 = uniform(rng, -2, 2);
+  const bool flip = uniform(rng, 0, 1) < 0.5;
+  Eigen::Isometry3d G = Eigen::Isometry3d::Identity();
+  switch (c) {
+    case QuadricClass::kSphere:
+      return makeIsometry(randomPose(rng).linear(), Eigen::Vector3d::Zero());
+    case QuadricClass::kCylinder:
+    case QuadricClass::kCone:
+      G.linear() = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      if (c == QuadricClass::kCylinder)
+        G.translation() = Eigen::Vector3d(0, 0, slide);
+      if (flip)
+        G.linear() =
+            G.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+      return G;
+    case QuadricClass::kPlane:
+      G.linear() = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()).toRotationMatrix();
+      G.translation() = Eigen::Vector3d(0, slide, slide2);
+      if (flip)
+        G.linear() =
+            G.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+      return G;
+    case QuadricClass::kGeneral:
+      break;
+  }
+  if (flip)
+    G.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  return G;
+}
+
 // Central differences of f: R^n -> R^m at x = 0 (the tangent origin), step h.
 inline Eigen::MatrixXd numericJacobian(
     const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f, int n, double h = 1e-6) {

@@ -8,44 +8,11 @@
 namespace quadric_slam {
 namespace {
 
-// A random element of the class's symmetry group, including discrete flips (quadric frame).
-Eigen::Isometry3d randomSymmetry(QuadricClass c, std::mt19937& rng) {
-  const double angle = test::uniform(rng, -M_PI, M_PI);
-  const double slide = test::uniform(rng, -2, 2), slide2 = test::uniform(rng, -2, 2);
-  const bool flip = test::uniform(rng, 0, 1) < 0.5;
-  Eigen::Isometry3d G = Eigen::Isometry3d::Identity();
-  switch (c) {
-    case QuadricClass::kSphere:
-      return makeIsometry(test::randomPose(rng).linear(), Eigen::Vector3d::Zero());
-    case QuadricClass::kCylinder:
-    case QuadricClass::kCone:
-      G.linear() = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      if (c == QuadricClass::kCylinder)
-        G.translation() = Eigen::Vector3d(0, 0, slide);
-      if (flip)
-        G.linear() =
-            G.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
-      return G;
-    case QuadricClass::kPlane:
-      G.linear() = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitX()).toRotationMatrix();
-      G.translation() = Eigen::Vector3d(0, slide, slide2);
-      if (flip)
-        G.linear() =
-            G.linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
-      return G;
-    case QuadricClass::kGeneral:
-      break;
-  }
-  if (flip)
-    G.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
-  return G;
-}
-
 void expectSurfaceMinusInvariant(QuadricClass c, int seed) {
   std::mt19937 rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
     const Quadric a = test::randomQuadric(c, rng);
-    const Eigen::Isometry3d G = randomSymmetry(c, rng);
+    const Eigen::Isometry3d G = test::randomSymmetry(c, rng);
     const Quadric same(c, a.pose() * G, a.scale(), a.signature());
     // Same surface (same Q), different frame: zero difference.
     ASSERT_LT((same.matrix() - a.matrix()).cwiseAbs().maxCoeff(), 1e-9);
@@ -55,7 +22,7 @@ void expectSurfaceMinusInvariant(QuadricClass c, int seed) {
     for (int i = 0; i < d.size(); ++i)
       d[i] = test::uniform(rng, -0.2, 0.2);
     const Quadric b = a.plusMinimal(d);
-    const Quadric b_other(c, b.pose() * randomSymmetry(c, rng), b.scale(), b.signature());
+    const Quadric b_other(c, b.pose() * test::randomSymmetry(c, rng), b.scale(), b.signature());
     EXPECT_LT((surfaceMinus(a, b) - surfaceMinus(a, b_other)).norm(), 1e-9);
     // ... and it recovers the minimal displacement that made b from a, up to sign.
     EXPECT_LT((surfaceMinus(b, a) - d).norm(), 1e-9) << toString(c) << " trial " << trial;
@@ -86,7 +53,7 @@ TEST(SymmetryAlignment, JacobianMatchesNumeric) {
       Vector6d xi;
       xi.head<3>() = test::randomVector(rng, 0.5);
       xi.tail<3>() = test::randomVector(rng, 0.4);
-      const Eigen::Isometry3d D = expSE3(xi) * randomSymmetry(c, rng);
+      const Eigen::Isometry3d D = expSE3(xi) * test::randomSymmetry(c, rng);
       auto aligned = [&](const Eigen::Isometry3d& Dp) -> Vector6d {
         return logSE3(symmetryAlignment(c, Dp).inverse() * Dp);
       };
