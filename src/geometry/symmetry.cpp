@@ -87,19 +87,36 @@ Eigen::Isometry3d symmetryAlignment(QuadricClass quadric_class, const Eigen::Iso
   return G_f * G_c;
 }
 
-Matrix6d alignedErrorJacobian(QuadricClass quadric_class, const Vector6d& e) {
+Matrix6d alignmentGeneratorRate(QuadricClass quadric_class, const Vector6d& e) {
   const QuadricClassDefinition& def = classDefinition(quadric_class);
-  const Matrix6d Jr_inv = rightJacobianInverseSE3(e);
   const int m = static_cast<int>(def.dropped_pose_indices.size());
   if (m == 0)
-    return Jr_inv;
+    return Matrix6d::Zero();
   Eigen::MatrixXd P = Eigen::MatrixXd::Zero(m, 6);
   for (int i = 0; i < m; ++i)
     P(i, def.dropped_pose_indices[i]) = 1.0;
-  const Matrix6d Jl_inv = leftJacobianInverseSE3(e);
-  const Eigen::MatrixXd PJP = P * Jl_inv * P.transpose();
-  const Eigen::MatrixXd correction = Jl_inv * P.transpose() * PJP.inverse() * P;
-  return (Matrix6d::Identity() - correction) * Jr_inv;
+  const Eigen::MatrixXd PJP = P * leftJacobianInverseSE3(e) * P.transpose();
+  return P.transpose() * PJP.inverse() * P * rightJacobianInverseSE3(e);
+}
+
+Matrix6d alignedErrorJacobian(QuadricClass quadric_class, const Vector6d& e) {
+  return rightJacobianInverseSE3(e) -
+         leftJacobianInverseSE3(e) * alignmentGeneratorRate(quadric_class, e);
+}
+
+Matrix6d adSE3(const Vector6d& xi) {
+  Matrix6d ad = Matrix6d::Zero();
+  ad.topLeftCorner<3, 3>() = skew(xi.tail<3>());
+  ad.bottomRightCorner<3, 3>() = skew(xi.tail<3>());
+  ad.topRightCorner<3, 3>() = skew(xi.head<3>());
+  return ad;
+}
+
+Eigen::MatrixXd minimalAdjoint(QuadricClass quadric_class, const Eigen::Isometry3d& G) {
+  const Matrix9Xd& B = classDefinition(quadric_class).basis;
+  Eigen::Matrix<double, 9, 9> ad = Eigen::Matrix<double, 9, 9>::Identity();
+  ad.topLeftCorner<6, 6>() = adjointSE3(G);
+  return basisPseudoInverse(quadric_class) * ad * B;
 }
 
 Quadric alignToReference(const Quadric& z, const Quadric& reference) {

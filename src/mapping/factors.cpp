@@ -37,7 +37,8 @@ QuadricObservationCost::QuadricObservationCost(const Quadric& z_camera,
     throw std::invalid_argument("QuadricObservationCost: sqrt_information must be " +
                                 std::to_string(k) + "x" + std::to_string(k) + " for a " +
                                 toString(z_camera.quadricClass()));
-  weighted_selection_ = sqrt_information * basisPseudoInverse(z_camera.quadricClass());
+  sqrt_information_ = sqrt_information;
+  basis_pinv_ = basisPseudoInverse(z_camera.quadricClass());
   set_num_residuals(k);
   mutable_parameter_block_sizes()->push_back(kPoseParameterSize);
   mutable_parameter_block_sizes()->push_back(kQuadricParameterSize);
@@ -61,22 +62,29 @@ bool QuadricObservationCost::Evaluate(double const* const* parameters, double* r
   Vector9d r9;
   r9.head<6>() = logSE3(G.inverse() * D);  // eq. 14: h [-] z G
   r9.tail<3>() = scale - z_.scale();       // eq. 16
+  const Eigen::MatrixXd LM = sqrt_information_ * minimalAdjoint(c, G);
   const int k = num_residuals();
-  Eigen::Map<Eigen::VectorXd>(residuals, k) = weighted_selection_ * r9;
+  Eigen::Map<Eigen::VectorXd>(residuals, k) = LM * (basis_pinv_ * r9);
   if (jacobians == nullptr)
     return true;
-  const Matrix6d K = alignedErrorJacobian(c, r9.head<6>());
+  const Vector6d e = r9.head<6>();
+  const Matrix6d K = alignedErrorJacobian(c, e);
+  // d r / d delta (D exp(delta^)), k x 6: the error's rate and the whitening's rate through G.
+  Eigen::Matrix<double, 9, 6> de9 = Eigen::Matrix<double, 9, 6>::Zero();
+  de9.topRows<6>() = K;
+  Eigen::Matrix<double, 9, 6> dM9 = Eigen::Matrix<double, 9, 6>::Zero();
+  dM9.topRows<6>() = adjointSE3(G) * adSE3(e) * alignmentGeneratorRate(c, e);
+  const Eigen::MatrixXd LN = LM * basis_pinv_ * de9 - sqrt_information_ * basis_pinv_ * dM9;
   if (jacobians[0] != nullptr) {
-    Eigen::Matrix<double, 9, 6> dr9_dcam = Eigen::Matrix<double, 9, 6>::Zero();
-    dr9_dcam.topRows<6>() = -K * adjointSE3(h.inverse());
     Eigen::Map<RowMajorMatrix>(jacobians[0], k, kPoseParameterSize) =
-        weighted_selection_ * dr9_dcam * poseMinusJacobian(parameters[0]);
+        -LN * adjointSE3(h.inverse()) * poseMinusJacobian(parameters[0]);
   }
   if (jacobians[1] != nullptr) {
-    Eigen::Matrix<double, 9, 9> dr9_dq = Eigen::Matrix<double, 9, 9>::Identity();
-    dr9_dq.topLeftCorner<6, 6>() = K;
+    Eigen::MatrixXd dr_dq9(k, 9);
+    dr_dq9.leftCols<6>() = LN;
+    dr_dq9.rightCols<3>() = LM * basis_pinv_.rightCols<3>();
     Eigen::Map<RowMajorMatrix>(jacobians[1], k, kQuadricParameterSize) =
-        weighted_selection_ * dr9_dq * quadricGeneralMinusJacobian(parameters[1]);
+        dr_dq9 * quadricGeneralMinusJacobian(parameters[1]);
   }
   return true;
 }

@@ -24,6 +24,18 @@ Eigen::Isometry3d symmetryAlignment(QuadricClass quadric_class, const Eigen::Iso
 // following the perturbation so that the dropped components stay zero (implicit function theorem):
 //   de = (I - J_l^-1 P^T (P J_l^-1 P^T)^-1 P) J_r^-1 delta,   J_l, J_r at e, P = dropped rows.
 Matrix6d alignedErrorJacobian(QuadricClass quadric_class, const Vector6d& e);
+// The rate of the symmetry generator in that perturbation: G(D exp(delta^)) = G exp(gamma^) with
+//   gamma = P^T (P J_l^-1 P^T)^-1 P J_r^-1 delta  (6 x 6, zero outside the dropped rows).
+// alignedErrorJacobian = J_r^-1 - J_l^-1 * alignmentGeneratorRate.
+Matrix6d alignmentGeneratorRate(QuadricClass quadric_class, const Vector6d& e);
+// ad(xi) = [phi^, rho^; 0, phi^], the SE(3) adjoint of the Lie algebra: Ad(exp(xi^)) = exp(ad(xi)).
+Matrix6d adSE3(const Vector6d& xi);
+
+// How a class's minimal vector (and hence its covariance) transforms when the quadric frame is
+// re-expressed by a symmetry element G: a perturbation nu of z is Ad(G^-1) nu for z G, so a minimal
+// vector x of z becomes minimalAdjoint(G^-1) x and a covariance C becomes M C M^T (k x k,
+// M = B^+ blockdiag(Ad_G, I) B; exact because each class's symmetries preserve its kept subspace).
+Eigen::MatrixXd minimalAdjoint(QuadricClass quadric_class, const Eigen::Isometry3d& G);
 
 // z re-expressed by the member of its symmetry orbit closest to `reference` (same surface).
 Quadric alignToReference(const Quadric& z, const Quadric& reference);

@@ -21,16 +21,23 @@ namespace quadric_slam {
 Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& covariance, const char* what);
 
 // Quadric observation factor. Measurement z = _C pi~ (quadric in the camera frame) of the class of
-// the landmark, covariance Sigma (k x k) in the class's minimal space (Table II).
+// the landmark, covariance Sigma (k x k) in the class's minimal space (Table II), expressed in z's
+// own frame: z = h [+] nu, nu ~ N(0, Sigma) (eq. 18).
 //
 // Derivation. Prediction h = T_WC^-1 T_WQ (eq. 19). With D = z^-1 h and G = symmetryAlignment(D)
 // (geometry/symmetry.h: z G is the member of z's symmetry orbit closest to h),
-//   e = log(G^-1 z^-1 h)^vee  (eq. 14, h [-] zG),   r = L B^+ [e; s_h - s_z]   (eqs. 16, 22)
-// so the dropped (symmetry) components of e are zero and r depends on the surfaces only.
+//   e = log(G^-1 z^-1 h)^vee  (eq. 14: h [-] zG),  x = B^+ [e; s_h - s_z]  (eq. 16, Table II)
+// and the dropped (symmetry) components of e are zero, so x depends on the surfaces only. The noise
+// of zG is Ad(G^-1) nu, so x ~ N(0, A Sigma A^T) with A = minimalAdjoint(G^-1); whitening with
+// L A^-1 = L M, M = minimalAdjoint(G), L^T L = Sigma^-1, gives the residual (eq. 22)
+//   r = L M(G) x,
+// which is then also independent of the frame the front-end chose for z (with its Sigma).
 // Perturbations (body frame): T_WQ exp(dq^) -> D exp(dq^); T_WC exp(dc^) -> D exp(-(Ad_{h^-1}
-// dc)^). With K = alignedErrorJacobian(e) (G follows the perturbation):
-//   dr/d(quadric tangent [dq; ds]) = L B^+ [K 0; 0 I],   dr/d(camera tangent) = L B^+ [-K
-//   Ad_{h^-1}; 0].
+// dc)^). For D exp(delta^): de = K delta with K = alignedErrorJacobian(e), and G -> G exp(gamma^)
+// with gamma = Gamma delta (alignmentGeneratorRate), so dM x = B^+ [Ad_G ad(gamma) e; 0] = -B^+
+// [Ad_G ad(e) Gamma delta; 0]. Hence dr/d delta = L (M B^+ [K; 0] - B^+ [Ad_G ad(e) Gamma; 0]) =: L
+// N,
+//   dr/d(quadric tangent [dq; ds]) = [L N, L M B^+_s],   dr/d(camera tangent) = -L N Ad_{h^-1}.
 class QuadricObservationCost : public ceres::CostFunction {
  public:
   QuadricObservationCost(const Quadric& z_camera, const Eigen::MatrixXd& sqrt_information);
@@ -41,7 +48,8 @@ class QuadricObservationCost : public ceres::CostFunction {
  private:
   Quadric z_;
   Eigen::Isometry3d T_quadric_camera_z_;  // z^-1
-  Eigen::MatrixXd weighted_selection_;    // L B^+ (k x 9)
+  Eigen::MatrixXd sqrt_information_;      // L (k x k)
+  Eigen::MatrixXd basis_pinv_;            // B^+ (k x 9)
 };
 
 // Relative pose (odometry) factor between T_WCi and T_WCj with measurement T_ij~ = T_i^-1 T_j:

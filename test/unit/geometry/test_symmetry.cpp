@@ -72,3 +72,28 @@ TEST(SymmetryAlignment, JacobianMatchesNumeric) {
 
 }  // namespace
 }  // namespace quadric_slam
+
+namespace quadric_slam {
+namespace {
+
+TEST(SymmetryAlignment, MinimalAdjointIsARepresentation) {
+  // M(G1 G2) = M(G1) M(G2) and M(G^-1) = M(G)^-1 on each class's minimal space: the symmetries
+  // preserve the kept subspace, so covariances can be carried between frames exactly.
+  std::mt19937 rng(37);
+  for (QuadricClass c : kAllQuadricClasses) {
+    for (int trial = 0; trial < 10; ++trial) {
+      const Eigen::Isometry3d G1 = test::randomSymmetry(c, rng), G2 = test::randomSymmetry(c, rng);
+      const Eigen::MatrixXd M12 = minimalAdjoint(c, G1 * G2);
+      EXPECT_LT((M12 - minimalAdjoint(c, G1) * minimalAdjoint(c, G2)).cwiseAbs().maxCoeff(), 1e-9)
+          << toString(c);
+      EXPECT_LT((minimalAdjoint(c, G1.inverse()) * minimalAdjoint(c, G1) -
+                 Eigen::MatrixXd::Identity(M12.rows(), M12.cols()))
+                    .cwiseAbs()
+                    .maxCoeff(),
+                1e-9);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace quadric_slam
