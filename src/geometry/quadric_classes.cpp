@@ -35,7 +35,8 @@ std::array<QuadricClassDefinition, 5> makeTable() {
           SymmetryGroup::kInPlaneMotions,
           Eigen::Vector3d::UnitX(),
           Eigen::Vector3d(1, 1, 1),
-          Eigen::Vector3d(1, 1, 1)};
+          Eigen::Vector3d(1, 1, 1),
+          Eigen::Matrix<double, Eigen::Dynamic, 9>()};
   // Table II, row "Sphere": (rho1, rho2, rho3, alpha), alpha = beta = gamma.
   t[1] = {QuadricClass::kSphere,
           Eigen::Vector4d(1, 1, 1, -1),
@@ -45,7 +46,8 @@ std::array<QuadricClassDefinition, 5> makeTable() {
           SymmetryGroup::kRotations,
           none,
           none,
-          none};
+          none,
+          Eigen::Matrix<double, Eigen::Dynamic, 9>()};
   // Table II, row "Circular Cylinder": (rho1, rho2, phi1, phi2, alpha), S = (alpha, alpha, 1).
   t[2] = {QuadricClass::kCylinder,
           Eigen::Vector4d(1, 1, 0, -1),
@@ -55,7 +57,8 @@ std::array<QuadricClassDefinition, 5> makeTable() {
           SymmetryGroup::kAxialScrew,
           Eigen::Vector3d::UnitZ(),
           Eigen::Vector3d(0, 0, 1),
-          Eigen::Vector3d(0, 0, 1)};
+          Eigen::Vector3d(0, 0, 1),
+          Eigen::Matrix<double, Eigen::Dynamic, 9>()};
   // Table II, row "Circular Cone": (rho1, rho2, rho3, phi1, phi2, alpha), S = (alpha, alpha, 1).
   t[3] = {QuadricClass::kCone,
           Eigen::Vector4d(1, 1, -1, 0),
@@ -65,7 +68,8 @@ std::array<QuadricClassDefinition, 5> makeTable() {
           SymmetryGroup::kAxialRotation,
           Eigen::Vector3d::UnitZ(),
           Eigen::Vector3d(0, 0, 1),
-          Eigen::Vector3d(0, 0, 1)};
+          Eigen::Vector3d(0, 0, 1),
+          Eigen::Matrix<double, Eigen::Dynamic, 9>()};
   // Table II, row "General": all nine.
   t[4] = {QuadricClass::kGeneral,
           Eigen::Vector4d(1, 1, 1, -1),
@@ -76,7 +80,10 @@ std::array<QuadricClassDefinition, 5> makeTable() {
           SymmetryGroup::kNone,
           none,
           none,
-          none};
+          none,
+          Eigen::Matrix<double, Eigen::Dynamic, 9>()};
+  for (QuadricClassDefinition& def : t)
+    def.basis_pinv = (def.basis.transpose() * def.basis).inverse() * def.basis.transpose();
   return t;
 }
 
@@ -90,9 +97,8 @@ const QuadricClassDefinition& classDefinition(QuadricClass quadric_class) {
   return table[index];
 }
 
-Eigen::MatrixXd basisPseudoInverse(QuadricClass quadric_class) {
-  const Matrix9Xd& B = classDefinition(quadric_class).basis;
-  return (B.transpose() * B).inverse() * B.transpose();
+const Eigen::Matrix<double, Eigen::Dynamic, 9>& basisPseudoInverse(QuadricClass quadric_class) {
+  return classDefinition(quadric_class).basis_pinv;
 }
 
 Eigen::Vector3d constrainScale(QuadricClass quadric_class, const Eigen::Vector3d& scale) {

@@ -42,6 +42,8 @@ struct QuadricClassDefinition {
   // value. Free entries are estimated through the scale columns of `basis`.
   Eigen::Vector3d fixed_scale_mask;
   Eigen::Vector3d fixed_scale_value;
+  // B^+ = (B^T B)^-1 B^T (k x 9), precomputed.
+  Eigen::Matrix<double, Eigen::Dynamic, 9> basis_pinv;
 };
 
 // The definition of a class (a static table; never throws for a valid enum value).
@@ -49,7 +51,7 @@ const QuadricClassDefinition& classDefinition(QuadricClass quadric_class);
 
 // Pseudo-inverse B^+ = (B^T B)^-1 B^T (k x 9): minimal vector of a general tangent vector. For the
 // orthonormal pose columns it selects; for the tied scale columns it averages.
-Eigen::MatrixXd basisPseudoInverse(QuadricClass quadric_class);
+const Eigen::Matrix<double, Eigen::Dynamic, 9>& basisPseudoInverse(QuadricClass quadric_class);
 
 // Scale diagonal (alpha, beta, gamma) obeying the class's ties and fixed values, from any input:
 // tied entries are averaged, fixed entries overwritten.
