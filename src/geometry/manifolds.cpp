@@ -119,7 +119,7 @@ QuadricManifold::QuadricManifold(QuadricClass quadric_class)
       basis_(classDefinition(quadric_class).basis),
       basis_pinv_(basisPseudoInverse(quadric_class)) {}
 
-// eqs. 10, 11, 15 through Table II's B
+// eqs. 9, 11, 16 through Table II's B
 bool QuadricManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
   const Eigen::Map<const Eigen::VectorXd> d(delta, basis_.cols());
   const Vector9d general = basis_ * d;
@@ -135,7 +135,7 @@ bool QuadricManifold::PlusJacobian(const double* x, double* jacobian) const {
   return true;
 }
 
-// eqs. 14, 16 through B^+
+// eqs. 10, 14, 17 through B^+
 bool QuadricManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
   Vector9d general;
   general.head<6>() = poseMinus(y, x);

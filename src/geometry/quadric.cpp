@@ -67,7 +67,7 @@ Quadric::Quadric(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_qu
   }
 }
 
-// eq. 5
+// eqs. 4-5
 Eigen::Matrix4d Quadric::matrix() const {
   Eigen::Matrix4d S_h = Eigen::Matrix4d::Identity();
   S_h.diagonal().head<3>() = scale_;
@@ -212,7 +212,7 @@ Quadric Quadric::transformed(const Eigen::Isometry3d& T_A_frame) const {
   return out;
 }
 
-// eqs. 10, 11 (body frame), 15
+// eqs. 9, 11 (body frame), 16
 Quadric Quadric::plus(const Vector9d& delta) const {
   Quadric out = *this;
   out.T_frame_quadric_ = quadric_slam::plus(T_frame_quadric_, delta.head<6>());
@@ -220,7 +220,7 @@ Quadric Quadric::plus(const Vector9d& delta) const {
   return out;
 }
 
-// eqs. 14, 16
+// eqs. 10, 14, 17
 Vector9d Quadric::minus(const Quadric& other) const {
   Vector9d d;
   d.head<6>() = quadric_slam::minus(T_frame_quadric_, other.T_frame_quadric_);

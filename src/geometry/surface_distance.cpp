@@ -36,7 +36,7 @@ Eigen::Vector3d closestOnCone(const Eigen::Vector3d& p, double theta) {
 
 }  // namespace
 
-// eq. 5 evaluated at the homogeneous point [p; 1]
+// eqs. 2 and 4 evaluated at the homogeneous point [p; 1]
 double algebraicDistance(const Quadric& q, const Eigen::Vector3d& p) {
   const Eigen::Vector3d y = q.scale().cwiseProduct(toQuadric(q, p));
   return y.dot(q.signature().head<3>().cwiseProduct(y)) + q.signature()[3];

@@ -61,7 +61,7 @@ bool QuadricObservationCost::Evaluate(double const* const* parameters, double* r
   const Eigen::Isometry3d G = symmetryAlignment(c, D);
   Vector9d r9;
   r9.head<6>() = logSE3(G.inverse() * D);  // eq. 14: h [-] z G
-  r9.tail<3>() = scale - z_.scale();       // eq. 16
+  r9.tail<3>() = scale - z_.scale();       // eq. 17
   const Eigen::MatrixXd LM = sqrt_information_ * minimalAdjoint(c, G);
   const int k = num_residuals();
   Eigen::Map<Eigen::VectorXd>(residuals, k) = LM * (basis_pinv_ * r9);

@@ -7,7 +7,7 @@
 //   diag(S)
 // Tangent spaces: pose [rho; phi] (6) applied in the body frame, x [+] xi = x exp(xi^) (se3.h);
 // quadric: the class's minimal vector (Table II, k = 3..9), mapped into [rho; phi; s] by the
-// class's B (quadric_classes.h): x [+] d = (T exp((B d)_pose^), S + D((B d)_scale)) (eqs. 10-16),
+// class's B (quadric_classes.h): x [+] d = (T exp((B d)_pose^), S + D((B d)_scale)) (eqs. 9-17),
 // Minus(y, x) = B^+ [log(T_x^-1 T_y)^vee; s_y - s_x].
 #pragma once
 

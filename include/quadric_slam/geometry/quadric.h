@@ -1,7 +1,11 @@
 // A quadric surface in the paper's minimal representation pi = (T_WQ, S, sigma) (Section III):
-// composition of the 4x4 matrix Q (eq. 5), its decomposition back into (T, S, sigma), the
+// composition of the 4x4 matrix Q (eqs. 4-5), its decomposition back into (T, S, sigma), the
 // [+]/[-] operators over SE(3) x D^3 (eqs. 10-17, body-frame convention, see se3.h) and the
 // measurement prediction h(T_WC, pi) (eq. 19).
+// Equation numbers count the paper's numbered equations in order: 2 z^T Q z = 0, 4 the
+// decomposition of Q, 5 S = diag(alpha, beta, gamma), 9-10 compound [+]/[-], 11 SE(3) [+],
+// 12-13 hat, 14 SE(3) [-], 15 vee, 16-17 D^3 [+]/[-], 18 noise, 19 h, 22 the cost.
+// (msg/QuadricSurface.msg cites "eq. 5" for the composition: eqs. 4 and 5 together.)
 #pragma once
 
 #include <Eigen/Core>
@@ -33,11 +37,11 @@ class Quadric {
   const Eigen::Vector3d& scale() const { return scale_; }  // diagonal of S (alpha, beta, gamma)
   const Eigen::Vector4d& signature() const { return signature_; }
 
-  // Q = T^T [S 0; 0 1]^T D(sigma) [S 0; 0 1] T with T = T_frame_quadric^-1 (eq. 5).
+  // Q = T^T [S 0; 0 1]^T D(sigma) [S 0; 0 1] T with T = T_frame_quadric^-1 (eqs. 4-5).
   Eigen::Matrix4d matrix() const;
 
   // Decomposes a real symmetric 4x4 Q (any nonzero projective scale and sign) into (T, S, sigma)
-  // by an eigen-decomposition of its upper 3x3 and Sylvester's law of inertia (eq. 5), the centre
+  // by an eigen-decomposition of its upper 3x3 and Sylvester's law of inertia (eq. 4), the centre
   // from the linear part. Supported: the double plane (alpha x)^2 = 0 (rank-1 Q), ellipsoid,
   // hyperboloids of one and two sheets, elliptic cone, elliptic and hyperbolic cylinders.
   // Signature convention: spatial entries +1 first, then -1, then 0 (the axis of a cylinder is
@@ -53,10 +57,10 @@ class Quadric {
   // This quadric expressed in frame A, given T_A_frame (the quadric currently lives in `frame`).
   Quadric transformed(const Eigen::Isometry3d& T_A_frame) const;
 
-  // pi [+] delta = (T exp(xi^), S + D(s)) with delta = [rho; phi; s] (eqs. 10, 11, 15; body frame).
+  // pi [+] delta = (T exp(xi^), S + D(s)) with delta = [rho; phi; s] (eqs. 9, 11, 16; body frame).
   // The class is kept; the caller keeps delta within the class (see plusMinimal).
   Quadric plus(const Vector9d& delta) const;
-  // pi [-] pi' = [log(T'^-1 T)^vee; D^-1(S - S')] (eqs. 14, 16). Exact inverse of plus().
+  // pi [-] pi' = [log(T'^-1 T)^vee; D^-1(S - S')] (eqs. 10, 14, 17). Exact inverse of plus().
   Vector9d minus(const Quadric& other) const;
   // The same through the class's minimal vector (Table II): plus(B delta), B^+ minus(other).
   Quadric plusMinimal(const Eigen::VectorXd& delta) const;

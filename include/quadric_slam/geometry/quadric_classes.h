@@ -26,7 +26,7 @@ enum class SymmetryGroup {
 
 struct QuadricClassDefinition {
   QuadricClass quadric_class;
-  Eigen::Vector4d signature;  // eq. 5 (for kGeneral: the ellipsoid, per quadric otherwise)
+  Eigen::Vector4d signature;  // eq. 4 (for kGeneral: the ellipsoid, per quadric otherwise)
   int minimal_dimension;      // Table II: 3, 4, 5, 6, 9
   // B (9 x k): general tangent [rho; phi; s] = B * minimal vector. Pose columns are unit vectors
   // (Table II's d xi / d xi_Q); scale columns tie entries: sphere (1,1,1), cylinder/cone (1,1,0).

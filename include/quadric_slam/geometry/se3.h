@@ -6,7 +6,7 @@
 // written they are not inverses of each other. The quadric pose operators here use the RIGHT
 // (body-frame) pair
 //     T [+] xi = T exp(xi^),      T [-] T' = log(T'^-1 T)^vee          (eq. 14 exactly)
-// so that (T [+] d) [-] T = d holds exactly. This is eq. 11 applied to the matrix that eq. 5
+// so that (T [+] d) [-] T = d holds exactly. This is eq. 11 applied to the matrix that eq. 4
 // actually multiplies, T_QW = T_WQ^-1, with the twist negated: (T_WQ exp(xi))^-1 = exp(-xi) T_QW.
 // The body-frame choice is what makes Table II work: its selection matrices name QUADRIC-frame
 // axes (plane normal = quadric x, cylinder/cone axis = quadric z), which are the invariant

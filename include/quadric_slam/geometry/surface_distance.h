@@ -9,7 +9,7 @@
 namespace quadric_slam {
 
 // f(p) = (S p_Q)^T D(sigma_1..3) (S p_Q) + sigma_4 with p_Q = T_frame_quadric^-1 p: the algebraic
-// value p~^T Q p~ of eq. 5 (zero on the surface).
+// value p~^T Q p~ of eqs. 2 and 4 (zero on the surface).
 double algebraicDistance(const Quadric& quadric, const Eigen::Vector3d& p);
 // grad f in the quadric's frame: 2 R S D(sigma_1..3) S p_Q.
 Eigen::Vector3d algebraicGradient(const Quadric& quadric, const Eigen::Vector3d& p);

@@ -26,7 +26,7 @@ Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& covariance, const char* w
 //
 // Derivation. Prediction h = T_WC^-1 T_WQ (eq. 19). With D = z^-1 h and G = symmetryAlignment(D)
 // (geometry/symmetry.h: z G is the member of z's symmetry orbit closest to h),
-//   e = log(G^-1 z^-1 h)^vee  (eq. 14: h [-] zG),  x = B^+ [e; s_h - s_z]  (eq. 16, Table II)
+//   e = log(G^-1 z^-1 h)^vee  (eq. 14: h [-] zG),  x = B^+ [e; s_h - s_z]  (eq. 17, Table II)
 // and the dropped (symmetry) components of e are zero, so x depends on the surfaces only. The noise
 // of zG is Ad(G^-1) nu, so x ~ N(0, A Sigma A^T) with A = minimalAdjoint(G^-1); whitening with
 // L A^-1 = L M, M = minimalAdjoint(G), L^T L = Sigma^-1, gives the residual (eq. 22)

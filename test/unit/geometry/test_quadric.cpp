@@ -107,6 +107,22 @@ TEST(Quadric, ComposeFollowsEquationFive) {
   EXPECT_NEAR(algebraicDistance(plane, Eigen::Vector3d(-5, 7, 4)), 1, 1e-12);  // (alpha x)^2
 }
 
+TEST(Quadric, PaperTableOneRowThree) {
+  // T_WQ = [1 0 0 0; 0 0 1 3; 0 -1 0 0; 0 0 0 1], S = diag(1, 0.5, 2): the ellipsoid with
+  // semi-axes (1, 2, 0.5) along quadric x, y, z = world x, -z, y, centred at (0, 3, 0).
+  Eigen::Matrix4d T;
+  T << 1, 0, 0, 0, 0, 0, 1, 3, 0, -1, 0, 0, 0, 0, 0, 1;
+  const Quadric q(QuadricClass::kGeneral, Eigen::Isometry3d(T), Eigen::Vector3d(1, 0.5, 2),
+                  Eigen::Vector4d(1, 1, 1, -1));
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(1, 3, 0), Eigen::Vector3d(0, 3, -2),
+                                   Eigen::Vector3d(0, 3, 2), Eigen::Vector3d(0, 3.5, 0)}) {
+    const Eigen::Vector4d ph(p.x(), p.y(), p.z(), 1);
+    EXPECT_NEAR(ph.dot(q.matrix() * ph), 0, 1e-12) << p.transpose();  // z^T Q z = 0 (eq. 2)
+  }
+  const Eigen::Vector4d centre(0, 3, 0, 1);
+  EXPECT_NEAR(centre.dot(q.matrix() * centre), -1, 1e-12);
+}
+
 TEST(Quadric, MeasurementTransformsLikeAQuadric) {
   // eq. 19: h(T_WC, pi) = (T_WC^-1 T_WQ, S), and then Q_C = T_WC^T Q_W T_WC.
   std::mt19937 rng(12);
