@@ -46,15 +46,15 @@ Eigen::Isometry3d poseFromParameters(const double* p) {
   return T;
 }
 
-void quadricToParameters(const Quadric& quadric, double* p) {
+void quadricToParameters(const QuadricModel& quadric, double* p) {
   poseToParameters(quadric.pose(), p);
   for (int i = 0; i < 3; ++i)
     p[7 + i] = quadric.scale()[i];
 }
 
-Quadric quadricFromParameters(const double* p, QuadricClass quadric_class,
+QuadricModel quadricFromParameters(const double* p, QuadricClass quadric_class,
                               const Eigen::Vector4d& signature) {
-  return Quadric(quadric_class, poseFromParameters(p), Eigen::Vector3d(p[7], p[8], p[9]),
+  return QuadricModel(quadric_class, poseFromParameters(p), Eigen::Vector3d(p[7], p[8], p[9]),
                  signature);
 }
 

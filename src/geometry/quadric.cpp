@@ -23,20 +23,20 @@ void checkScaleTies(QuadricClass c, const Eigen::Vector3d& scale, double tol) {
   const Eigen::Vector3d constrained = constrainScale(c, scale);
   if ((constrained - scale).cwiseAbs().maxCoeff() >
       tol * std::max(1.0, scale.cwiseAbs().maxCoeff()))
-    throw std::invalid_argument("Quadric: scale " + vecString(scale) + " violates the " +
+    throw std::invalid_argument("QuadricModel: scale " + vecString(scale) + " violates the " +
                                 toString(c) + " class constraint, expected " +
                                 vecString(constrained));
 }
 
 }  // namespace
 
-Quadric::Quadric() = default;
+QuadricModel::QuadricModel() = default;
 
-Quadric::Quadric(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
+QuadricModel::QuadricModel(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
                  const Eigen::Vector3d& scale)
-    : Quadric(quadric_class, T_frame_quadric, scale, defaultSignature(quadric_class)) {}
+    : QuadricModel(quadric_class, T_frame_quadric, scale, defaultSignature(quadric_class)) {}
 
-Quadric::Quadric(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
+QuadricModel::QuadricModel(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
                  const Eigen::Vector3d& scale, const Eigen::Vector4d& signature)
     : class_(quadric_class),
       T_frame_quadric_(T_frame_quadric),
@@ -45,47 +45,47 @@ Quadric::Quadric(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_qu
   classDefinition(quadric_class);  // validates the enum value
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(scale[i]) || scale[i] <= 0)
-      throw std::invalid_argument("Quadric: scale " + vecString(scale) +
+      throw std::invalid_argument("QuadricModel: scale " + vecString(scale) +
                                   " must be finite and > 0 in every entry");
   }
   for (int i = 0; i < 4; ++i) {
     if (signature[i] != 1 && signature[i] != -1 && signature[i] != 0)
-      throw std::invalid_argument("Quadric: signature " + vecString(signature) +
+      throw std::invalid_argument("QuadricModel: signature " + vecString(signature) +
                                   " must have entries in {+1, -1, 0}");
   }
   if (!T_frame_quadric.matrix().allFinite())
-    throw std::invalid_argument("Quadric: pose is not finite");
+    throw std::invalid_argument("QuadricModel: pose is not finite");
   if (quadric_class != QuadricClass::kGeneral) {
     if (signature != defaultSignature(quadric_class))
-      throw std::invalid_argument("Quadric: a " + toString(quadric_class) + " has signature " +
+      throw std::invalid_argument("QuadricModel: a " + toString(quadric_class) + " has signature " +
                                   vecString(defaultSignature(quadric_class)) + ", got " +
                                   vecString(signature));
     checkScaleTies(quadric_class, scale, 1e-6);
   } else if (signature.head<3>().cwiseAbs().sum() == 0) {
-    throw std::invalid_argument("Quadric: signature " + vecString(signature) +
+    throw std::invalid_argument("QuadricModel: signature " + vecString(signature) +
                                 " has no quadratic part");
   }
 }
 
 // eqs. 4-5
-Eigen::Matrix4d Quadric::matrix() const {
+Eigen::Matrix4d QuadricModel::matrix() const {
   Eigen::Matrix4d S_h = Eigen::Matrix4d::Identity();
   S_h.diagonal().head<3>() = scale_;
   const Eigen::Matrix4d T = T_frame_quadric_.inverse().matrix();
   return T.transpose() * S_h.transpose() * signature_.asDiagonal() * S_h * T;
 }
 
-Quadric Quadric::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_class,
+QuadricModel QuadricModel::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_class,
                             double relative_tolerance) {
   classDefinition(quadric_class);
   if (!Q_in.allFinite())
-    throw std::invalid_argument("Quadric::fromMatrix: Q is not finite");
+    throw std::invalid_argument("QuadricModel::fromMatrix: Q is not finite");
   const double norm = Q_in.cwiseAbs().maxCoeff();
   if (norm == 0)
-    throw std::invalid_argument("Quadric::fromMatrix: Q is zero");
+    throw std::invalid_argument("QuadricModel::fromMatrix: Q is zero");
   const Eigen::Matrix4d Q = Q_in / norm;
   if ((Q - Q.transpose()).cwiseAbs().maxCoeff() > 1e-9)
-    throw std::invalid_argument("Quadric::fromMatrix: Q is not symmetric");
+    throw std::invalid_argument("QuadricModel::fromMatrix: Q is not symmetric");
   const double tol = 1e-9;  // rank tolerance on the normalised Q
 
   const Eigen::Matrix3d A = Q.topLeftCorner<3, 3>();
@@ -97,7 +97,7 @@ Quadric Quadric::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_cl
   const double lambda_max = lambda.cwiseAbs().maxCoeff();
   if (lambda_max <= tol)
     throw std::invalid_argument(
-        "Quadric::fromMatrix: Q has no quadratic part (a single plane in linear form is not a "
+        "QuadricModel::fromMatrix: Q has no quadratic part (a single plane in linear form is not a "
         "supported quadric; planes use the double-plane form (alpha x)^2 = 0)");
   const double rank_tol = std::max(tol, relative_tolerance * 1e-3 * lambda_max);
   int rank = 0;
@@ -117,20 +117,20 @@ Quadric Quadric::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_cl
     const double beta = n.dot(b);
     if ((b - beta * n).norm() > 1e3 * tol || std::abs(c - beta * beta / l) > 1e3 * tol)
       throw std::invalid_argument(
-          "Quadric::fromMatrix: rank-1 quadratic part but Q is not a double plane (parabolic "
+          "QuadricModel::fromMatrix: rank-1 quadratic part but Q is not a double plane (parabolic "
           "cylinder or pair of parallel planes: not supported)");
     if (quadric_class != QuadricClass::kPlane)
-      throw std::invalid_argument("Quadric::fromMatrix: Q is a plane, requested class " +
+      throw std::invalid_argument("QuadricModel::fromMatrix: Q is a plane, requested class " +
                                   toString(quadric_class));
     const double d = -beta / l;  // n.p = d
     Eigen::Matrix3d R;
     R.col(0) = n;
     R.col(1) = n.unitOrthogonal();
     R.col(2) = n.cross(R.col(1));
-    return Quadric(QuadricClass::kPlane, makeIsometry(R, d * n), Eigen::Vector3d::Ones());
+    return QuadricModel(QuadricClass::kPlane, makeIsometry(R, d * n), Eigen::Vector3d::Ones());
   }
   if (quadric_class == QuadricClass::kPlane)
-    throw std::invalid_argument("Quadric::fromMatrix: requested a plane, but Q has rank-" +
+    throw std::invalid_argument("QuadricModel::fromMatrix: requested a plane, but Q has rank-" +
                                 std::to_string(rank) + " quadratic part");
 
   // Centre: A t = -b on the range of A; b must lie in that range (no paraboloids).
@@ -142,7 +142,7 @@ Quadric Quadric::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_cl
   for (int i = 0; i < 3; ++i) {
     if (lambda[i] == 0 && std::abs(V.col(i).dot(b)) > 1e3 * rank_tol)
       throw std::invalid_argument(
-          "Quadric::fromMatrix: the linear part is not in the range of the quadratic part "
+          "QuadricModel::fromMatrix: the linear part is not in the range of the quadratic part "
           "(paraboloid or parabolic cylinder): not supported");
   }
   const Eigen::Vector3d t = -A_pinv * b;
@@ -151,7 +151,7 @@ Quadric Quadric::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_cl
     k = 0;
   if (k == 0 && rank == 2)
     throw std::invalid_argument(
-        "Quadric::fromMatrix: degenerate Q (pair of intersecting planes or a line)");
+        "QuadricModel::fromMatrix: degenerate Q (pair of intersecting planes or a line)");
 
   // Sylvester's law of inertia: the sign pattern of (lambda, k) up to the overall sign.
   int pos = 0, neg = 0;
@@ -167,9 +167,9 @@ Quadric Quadric::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_cl
   if (overall < 0)
     std::swap(pos, neg);
   if (neg == 0 && k > 0)
-    throw std::invalid_argument("Quadric::fromMatrix: Q has no real points (imaginary quadric)");
+    throw std::invalid_argument("QuadricModel::fromMatrix: Q has no real points (imaginary quadric)");
   if (neg == 0 && k == 0)
-    throw std::invalid_argument("Quadric::fromMatrix: degenerate Q (a single point)");
+    throw std::invalid_argument("QuadricModel::fromMatrix: degenerate Q (a single point)");
 
   // Order the axes: +1 first, then -1, then 0.
   std::vector<int> order = {0, 1, 2};
@@ -179,7 +179,7 @@ Quadric Quadric::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_cl
   double unit = std::abs(k);
   if (k == 0) {
     if (neg != 1)
-      throw std::invalid_argument("Quadric::fromMatrix: unsupported cone signature");
+      throw std::invalid_argument("QuadricModel::fromMatrix: unsupported cone signature");
     unit = std::abs(lambda[order[2]]);
   }
   Eigen::Matrix3d R;
@@ -197,52 +197,52 @@ Quadric Quadric::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_cl
 
   if (quadric_class != QuadricClass::kGeneral) {
     if (sigma != defaultSignature(quadric_class))
-      throw std::invalid_argument("Quadric::fromMatrix: Q has signature " + vecString(sigma) +
+      throw std::invalid_argument("QuadricModel::fromMatrix: Q has signature " + vecString(sigma) +
                                   ", not that of a " + toString(quadric_class) + " " +
                                   vecString(defaultSignature(quadric_class)));
     checkScaleTies(quadric_class, scale, relative_tolerance);
     scale = constrainScale(quadric_class, scale);
   }
-  return Quadric(quadric_class, makeIsometry(R, t), scale, sigma);
+  return QuadricModel(quadric_class, makeIsometry(R, t), scale, sigma);
 }
 
-Quadric Quadric::transformed(const Eigen::Isometry3d& T_A_frame) const {
-  Quadric out = *this;
+QuadricModel QuadricModel::transformed(const Eigen::Isometry3d& T_A_frame) const {
+  QuadricModel out = *this;
   out.T_frame_quadric_ = T_A_frame * T_frame_quadric_;
   return out;
 }
 
 // eqs. 9, 11 (body frame), 16
-Quadric Quadric::plus(const Vector9d& delta) const {
-  Quadric out = *this;
+QuadricModel QuadricModel::plus(const Vector9d& delta) const {
+  QuadricModel out = *this;
   out.T_frame_quadric_ = quadric_slam::plus(T_frame_quadric_, delta.head<6>());
   out.scale_ = scale_ + delta.tail<3>();
   return out;
 }
 
 // eqs. 10, 14, 17
-Vector9d Quadric::minus(const Quadric& other) const {
+Vector9d QuadricModel::minus(const QuadricModel& other) const {
   Vector9d d;
   d.head<6>() = quadric_slam::minus(T_frame_quadric_, other.T_frame_quadric_);
   d.tail<3>() = scale_ - other.scale_;
   return d;
 }
 
-Quadric Quadric::plusMinimal(const Eigen::VectorXd& delta) const {
+QuadricModel QuadricModel::plusMinimal(const Eigen::VectorXd& delta) const {
   const QuadricClassDefinition& def = classDefinition(class_);
   if (delta.size() != def.minimal_dimension)
-    throw std::invalid_argument("Quadric::plusMinimal: a " + toString(class_) + " takes " +
+    throw std::invalid_argument("QuadricModel::plusMinimal: a " + toString(class_) + " takes " +
                                 std::to_string(def.minimal_dimension) + " parameters, got " +
                                 std::to_string(delta.size()));
   return plus(def.basis * delta);
 }
 
-Eigen::VectorXd Quadric::minusMinimal(const Quadric& other) const {
+Eigen::VectorXd QuadricModel::minusMinimal(const QuadricModel& other) const {
   return basisPseudoInverse(class_) * minus(other);
 }
 
 // eq. 19
-Quadric predictMeasurement(const Eigen::Isometry3d& T_world_camera, const Quadric& quadric_world) {
+QuadricModel predictMeasurement(const Eigen::Isometry3d& T_world_camera, const QuadricModel& quadric_world) {
   return quadric_world.transformed(T_world_camera.inverse());
 }
 

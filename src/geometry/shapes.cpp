@@ -7,7 +7,7 @@ namespace quadric_slam {
 
 namespace {
 
-void requireClass(const Quadric& q, QuadricClass c, const char* fn) {
+void requireClass(const QuadricModel& q, QuadricClass c, const char* fn) {
   if (q.quadricClass() != c)
     throw std::invalid_argument(std::string(fn) + ": expected a " + toString(c) + ", got a " +
                                 toString(q.quadricClass()));
@@ -59,7 +59,7 @@ Eigen::Matrix3d rotationWithAxis(const Eigen::Vector3d& direction, int column) {
   return R;
 }
 
-PlaneShape planeShape(const Quadric& q) {
+PlaneShape planeShape(const QuadricModel& q) {
   requireClass(q, QuadricClass::kPlane, "planeShape");
   PlaneShape s;
   s.normal = q.pose().linear().col(0);
@@ -67,55 +67,55 @@ PlaneShape planeShape(const Quadric& q) {
   return s;
 }
 
-SphereShape sphereShape(const Quadric& q) {
+SphereShape sphereShape(const QuadricModel& q) {
   requireClass(q, QuadricClass::kSphere, "sphereShape");
   return {q.pose().translation(), 1.0 / q.scale().x()};
 }
 
-CylinderShape cylinderShape(const Quadric& q) {
+CylinderShape cylinderShape(const QuadricModel& q) {
   requireClass(q, QuadricClass::kCylinder, "cylinderShape");
   return {q.pose().translation(), q.pose().linear().col(2), 1.0 / q.scale().x()};
 }
 
-ConeShape coneShape(const Quadric& q) {
+ConeShape coneShape(const QuadricModel& q) {
   requireClass(q, QuadricClass::kCone, "coneShape");
   return {q.pose().translation(), q.pose().linear().col(2), std::atan2(1.0, q.scale().x())};
 }
 
-Quadric quadricFromShape(const PlaneShape& s) {
+QuadricModel quadricFromShape(const PlaneShape& s) {
   const Eigen::Vector3d n = unitDirection(s.normal, "plane normal");
   if (!std::isfinite(s.offset))
     throw std::invalid_argument("plane offset must be finite");
-  return Quadric(QuadricClass::kPlane, makeIsometry(rotationWithAxis(n, 0), s.offset * n),
+  return QuadricModel(QuadricClass::kPlane, makeIsometry(rotationWithAxis(n, 0), s.offset * n),
                  Eigen::Vector3d::Ones());
 }
 
-Quadric quadricFromShape(const SphereShape& s) {
+QuadricModel quadricFromShape(const SphereShape& s) {
   requirePositive(s.radius, "sphere radius");
   const double a = 1.0 / s.radius;
-  return Quadric(QuadricClass::kSphere, makeIsometry(Eigen::Matrix3d::Identity(), s.center),
+  return QuadricModel(QuadricClass::kSphere, makeIsometry(Eigen::Matrix3d::Identity(), s.center),
                  Eigen::Vector3d(a, a, a));
 }
 
-Quadric quadricFromShape(const CylinderShape& s) {
+QuadricModel quadricFromShape(const CylinderShape& s) {
   requirePositive(s.radius, "cylinder radius");
   const Eigen::Vector3d d = unitDirection(s.axis, "cylinder axis");
   const double a = 1.0 / s.radius;
-  return Quadric(QuadricClass::kCylinder, makeIsometry(rotationWithAxis(d, 2), s.point),
+  return QuadricModel(QuadricClass::kCylinder, makeIsometry(rotationWithAxis(d, 2), s.point),
                  Eigen::Vector3d(a, a, 1));
 }
 
-Quadric quadricFromShape(const ConeShape& s) {
+QuadricModel quadricFromShape(const ConeShape& s) {
   if (!(s.half_angle > 0 && s.half_angle < M_PI / 2))
     throw std::invalid_argument("cone half_angle must be in (0, pi/2) rad, got " +
                                 std::to_string(s.half_angle));
   const Eigen::Vector3d d = unitDirection(s.axis, "cone axis");
   const double a = 1.0 / std::tan(s.half_angle);
-  return Quadric(QuadricClass::kCone, makeIsometry(rotationWithAxis(d, 2), s.apex),
+  return QuadricModel(QuadricClass::kCone, makeIsometry(rotationWithAxis(d, 2), s.apex),
                  Eigen::Vector3d(a, a, 1));
 }
 
-std::vector<double> shapeVector(const Quadric& q) {
+std::vector<double> shapeVector(const QuadricModel& q) {
   std::vector<double> out;
   switch (q.quadricClass()) {
     case QuadricClass::kPlane: {
@@ -150,7 +150,7 @@ std::vector<double> shapeVector(const Quadric& q) {
   return out;
 }
 
-Quadric quadricFromShapeVector(QuadricClass c, const std::vector<double>& v) {
+QuadricModel quadricFromShapeVector(QuadricClass c, const std::vector<double>& v) {
   const size_t expected = c == QuadricClass::kPlane || c == QuadricClass::kSphere ? 4 : 7;
   if (c == QuadricClass::kGeneral)
     throw std::invalid_argument(
@@ -171,7 +171,7 @@ Quadric quadricFromShapeVector(QuadricClass c, const std::vector<double>& v) {
   }
 }
 
-std::map<std::string, std::vector<double>> shapeMap(const Quadric& q) {
+std::map<std::string, std::vector<double>> shapeMap(const QuadricModel& q) {
   const std::vector<double> v = shapeVector(q);
   switch (q.quadricClass()) {
     case QuadricClass::kPlane:
@@ -188,7 +188,7 @@ std::map<std::string, std::vector<double>> shapeMap(const Quadric& q) {
   return {};
 }
 
-Quadric quadricFromShapeMap(QuadricClass c, const std::map<std::string, std::vector<double>>& m) {
+QuadricModel quadricFromShapeMap(QuadricClass c, const std::map<std::string, std::vector<double>>& m) {
   std::vector<double> v;
   switch (c) {
     case QuadricClass::kPlane:

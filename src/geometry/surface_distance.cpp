@@ -9,7 +9,7 @@ namespace quadric_slam {
 
 namespace {
 
-Eigen::Vector3d toQuadric(const Quadric& q, const Eigen::Vector3d& p) {
+Eigen::Vector3d toQuadric(const QuadricModel& q, const Eigen::Vector3d& p) {
   return q.pose().inverse() * p;
 }
 
@@ -37,19 +37,19 @@ Eigen::Vector3d closestOnCone(const Eigen::Vector3d& p, double theta) {
 }  // namespace
 
 // eqs. 2 and 4 evaluated at the homogeneous point [p; 1]
-double algebraicDistance(const Quadric& q, const Eigen::Vector3d& p) {
+double algebraicDistance(const QuadricModel& q, const Eigen::Vector3d& p) {
   const Eigen::Vector3d y = q.scale().cwiseProduct(toQuadric(q, p));
   return y.dot(q.signature().head<3>().cwiseProduct(y)) + q.signature()[3];
 }
 
-Eigen::Vector3d algebraicGradient(const Quadric& q, const Eigen::Vector3d& p) {
+Eigen::Vector3d algebraicGradient(const QuadricModel& q, const Eigen::Vector3d& p) {
   const Eigen::Vector3d s = q.scale();
   const Eigen::Vector3d local =
       2.0 * s.cwiseProduct(q.signature().head<3>().cwiseProduct(s.cwiseProduct(toQuadric(q, p))));
   return q.pose().linear() * local;
 }
 
-double firstOrderDistance(const Quadric& q, const Eigen::Vector3d& p) {
+double firstOrderDistance(const QuadricModel& q, const Eigen::Vector3d& p) {
   const double f = algebraicDistance(q, p);
   const double g = algebraicGradient(q, p).norm();
   if (f == 0)
@@ -59,7 +59,7 @@ double firstOrderDistance(const Quadric& q, const Eigen::Vector3d& p) {
   return std::abs(f) / g;
 }
 
-double exactDistance(const Quadric& q, const Eigen::Vector3d& p) {
+double exactDistance(const QuadricModel& q, const Eigen::Vector3d& p) {
   const Eigen::Vector3d pq = toQuadric(q, p);
   switch (q.quadricClass()) {
     case QuadricClass::kPlane:
@@ -91,7 +91,7 @@ SurfaceProjector::SurfaceProjector(const Params& params) : params_(params) {
   params_.validate();
 }
 
-Eigen::Vector3d SurfaceProjector::project(const Quadric& q, const Eigen::Vector3d& p) const {
+Eigen::Vector3d SurfaceProjector::project(const QuadricModel& q, const Eigen::Vector3d& p) const {
   const Eigen::Vector3d pq = toQuadric(q, p);
   Eigen::Vector3d out;
   switch (q.quadricClass()) {

@@ -119,13 +119,13 @@ Eigen::MatrixXd minimalAdjoint(QuadricClass quadric_class, const Eigen::Isometry
   return basisPseudoInverse(quadric_class) * ad * B;
 }
 
-Quadric alignToReference(const Quadric& z, const Quadric& reference) {
+QuadricModel alignToReference(const QuadricModel& z, const QuadricModel& reference) {
   const Eigen::Isometry3d T_z_h = z.pose().inverse() * reference.pose();
   const Eigen::Isometry3d G = symmetryAlignment(z.quadricClass(), T_z_h);
-  return Quadric(z.quadricClass(), z.pose() * G, z.scale(), z.signature());
+  return QuadricModel(z.quadricClass(), z.pose() * G, z.scale(), z.signature());
 }
 
-Eigen::VectorXd surfaceMinus(const Quadric& a, const Quadric& b) {
+Eigen::VectorXd surfaceMinus(const QuadricModel& a, const QuadricModel& b) {
   if (a.quadricClass() != b.quadricClass())
     throw std::invalid_argument("surfaceMinus: classes differ (" + toString(a.quadricClass()) +
                                 " vs " + toString(b.quadricClass()) + ")");

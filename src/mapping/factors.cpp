@@ -29,7 +29,7 @@ Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& covariance, const char* w
   return llt.matrixU();
 }
 
-QuadricObservationCost::QuadricObservationCost(const Quadric& z_camera,
+QuadricObservationCost::QuadricObservationCost(const QuadricModel& z_camera,
                                                const Eigen::MatrixXd& sqrt_information)
     : z_(z_camera), T_quadric_camera_z_(z_camera.pose().inverse()) {
   const int k = classDefinition(z_camera.quadricClass()).minimal_dimension;
@@ -44,7 +44,7 @@ QuadricObservationCost::QuadricObservationCost(const Quadric& z_camera,
   mutable_parameter_block_sizes()->push_back(kQuadricParameterSize);
 }
 
-ceres::CostFunction* QuadricObservationCost::Create(const Quadric& z_camera,
+ceres::CostFunction* QuadricObservationCost::Create(const QuadricModel& z_camera,
                                                     const Eigen::MatrixXd& covariance) {
   return new QuadricObservationCost(z_camera,
                                     sqrtInformation(covariance, "QuadricObservationCost"));

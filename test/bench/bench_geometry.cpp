@@ -1,8 +1,6 @@
 // Benchmark of the geometry core (not a test): per-call cost of Q decomposition and of the
-// observation factor with Jacobians, per class. Not built by CMake; build and run with
-//   g++ -O2 -std=c++17 -Iinclude -I/usr/include/eigen3 test/bench/bench_geometry.cpp \
-//     -L.ws/devel/lib -Wl,-rpath,$PWD/.ws/devel/lib -lquadric_slam_core -lceres -lglog \
-//     -o /tmp/bench_geometry && /tmp/bench_geometry
+// observation factor with Jacobians, per class. Built with the package; run
+//   .ws/devel/lib/quadric_slam/bench_geometry
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -24,17 +22,17 @@ Eigen::Isometry3d randomPose(std::mt19937& rng) {
                       Eigen::Vector3d(u(rng), u(rng), u(rng)) * 2);
 }
 
-Quadric randomQuadric(QuadricClass c, std::mt19937& rng) {
+QuadricModel randomQuadric(QuadricClass c, std::mt19937& rng) {
   switch (c) {
     case QuadricClass::kPlane:
-      return Quadric(c, randomPose(rng), Eigen::Vector3d::Ones());
+      return QuadricModel(c, randomPose(rng), Eigen::Vector3d::Ones());
     case QuadricClass::kSphere:
-      return Quadric(c, randomPose(rng), Eigen::Vector3d::Constant(2));
+      return QuadricModel(c, randomPose(rng), Eigen::Vector3d::Constant(2));
     case QuadricClass::kCylinder:
     case QuadricClass::kCone:
-      return Quadric(c, randomPose(rng), Eigen::Vector3d(2, 2, 1));
+      return QuadricModel(c, randomPose(rng), Eigen::Vector3d(2, 2, 1));
     default:
-      return Quadric(c, randomPose(rng), Eigen::Vector3d(1, 2, 3), Eigen::Vector4d(1, 1, 1, -1));
+      return QuadricModel(c, randomPose(rng), Eigen::Vector3d(1, 2, 3), Eigen::Vector4d(1, 1, 1, -1));
   }
 }
 
@@ -55,7 +53,7 @@ int main() {
   std::printf("%-9s %14s %22s %22s\n", "class", "fromMatrix ns", "factor residual ns",
               "factor +jacobians ns");
   for (QuadricClass c : kAllQuadricClasses) {
-    std::vector<Quadric> quadrics;
+    std::vector<QuadricModel> quadrics;
     std::vector<Eigen::Matrix4d> matrices;
     for (int i = 0; i < 64; ++i) {
       quadrics.push_back(randomQuadric(c, rng));
@@ -63,7 +61,7 @@ int main() {
     }
     volatile double sink = 0;
     const double t_decompose = nanosecondsPerCall(n, [&](int i) {
-      sink = sink + Quadric::fromMatrix(matrices[i % 64], c).scale().x();
+      sink = sink + QuadricModel::fromMatrix(matrices[i % 64], c).scale().x();
     });
     const int k = minimalDimension(c);
     std::unique_ptr<ceres::CostFunction> cost(QuadricObservationCost::Create(

@@ -31,24 +31,24 @@ inline Eigen::Isometry3d randomPose(std::mt19937& rng, double translation_scale 
 }
 
 // A random quadric of the class; for kGeneral the signature is given (default: ellipsoid).
-inline Quadric randomQuadric(QuadricClass c, std::mt19937& rng,
+inline QuadricModel randomQuadric(QuadricClass c, std::mt19937& rng,
                              const Eigen::Vector4d& general_signature = Eigen::Vector4d(1, 1, 1,
                                                                                         -1)) {
   const Eigen::Isometry3d T = randomPose(rng);
   switch (c) {
     case QuadricClass::kPlane:
-      return Quadric(c, T, Eigen::Vector3d::Ones());
+      return QuadricModel(c, T, Eigen::Vector3d::Ones());
     case QuadricClass::kSphere: {
       const double a = 1.0 / uniform(rng, 0.2, 2.0);
-      return Quadric(c, T, Eigen::Vector3d(a, a, a));
+      return QuadricModel(c, T, Eigen::Vector3d(a, a, a));
     }
     case QuadricClass::kCylinder: {
       const double a = 1.0 / uniform(rng, 0.1, 1.5);
-      return Quadric(c, T, Eigen::Vector3d(a, a, 1));
+      return QuadricModel(c, T, Eigen::Vector3d(a, a, 1));
     }
     case QuadricClass::kCone: {
       const double a = 1.0 / std::tan(uniform(rng, 0.2, 1.2));
-      return Quadric(c, T, Eigen::Vector3d(a, a, 1));
+      return QuadricModel(c, T, Eigen::Vector3d(a, a, 1));
     }
     case QuadricClass::kGeneral:
       break;
@@ -58,7 +58,7 @@ inline Quadric randomQuadric(QuadricClass c, std::mt19937& rng,
     if (general_signature[i] == 0)
       s[i] = 1.0;
   }
-  return Quadric(c, T, s, general_signature);
+  return QuadricModel(c, T, s, general_signature);
 }
 
 // A random element of the class's symmetry group, including discrete flips (quadric frame).

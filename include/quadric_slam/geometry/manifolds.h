@@ -27,9 +27,9 @@ constexpr int kQuadricParameterSize = 10;
 
 void poseToParameters(const Eigen::Isometry3d& T, double* parameters);
 Eigen::Isometry3d poseFromParameters(const double* parameters);
-void quadricToParameters(const Quadric& quadric, double* parameters);
-// Throws std::invalid_argument (from Quadric) when the block holds an invalid quadric.
-Quadric quadricFromParameters(const double* parameters, QuadricClass quadric_class,
+void quadricToParameters(const QuadricModel& quadric, double* parameters);
+// Throws std::invalid_argument (from QuadricModel) when the block holds an invalid quadric.
+QuadricModel quadricFromParameters(const double* parameters, QuadricClass quadric_class,
                               const Eigen::Vector4d& signature);
 
 // d(ambient)/d(tangent) of the pose Plus at delta = 0 (7 x 6) and a left inverse of it, the

@@ -18,17 +18,19 @@ namespace quadric_slam {
 
 using Vector9d = Eigen::Matrix<double, 9, 1>;
 
-class Quadric {
+// The paper's quadric pi = (T_WQ, S, sigma) with its class. (Named QuadricModel because the message
+// quadric_slam::Quadric, a map landmark, lives in the same C++ namespace.)
+class QuadricModel {
  public:
   // Unit sphere at the origin.
-  Quadric();
+  QuadricModel();
   // Throws std::invalid_argument when a scale entry is not finite and positive, the signature is
   // not made of +1/-1/0 entries, or a non-general class is given a signature other than its own.
   // For the classes of revolution the scale must obey the class's ties (sphere alpha=beta=gamma,
   // cylinder/cone alpha=beta with gamma=1, plane (1,1,1)) to relative 1e-6.
-  Quadric(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
+  QuadricModel(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
           const Eigen::Vector3d& scale);
-  Quadric(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
+  QuadricModel(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
           const Eigen::Vector3d& scale, const Eigen::Vector4d& signature);
 
   QuadricClass quadricClass() const { return class_; }
@@ -51,20 +53,20 @@ class Quadric {
   // non-finite Q, degenerate Q (zero, pairs of planes, single point), quadrics without real points,
   // paraboloids and parabolic cylinders (not supported), or when the result is not of the requested
   // class (e.g. unequal scales for kSphere) to within relative_tolerance.
-  static Quadric fromMatrix(const Eigen::Matrix4d& Q, QuadricClass quadric_class,
+  static QuadricModel fromMatrix(const Eigen::Matrix4d& Q, QuadricClass quadric_class,
                             double relative_tolerance = 1e-6);
 
   // This quadric expressed in frame A, given T_A_frame (the quadric currently lives in `frame`).
-  Quadric transformed(const Eigen::Isometry3d& T_A_frame) const;
+  QuadricModel transformed(const Eigen::Isometry3d& T_A_frame) const;
 
   // pi [+] delta = (T exp(xi^), S + D(s)) with delta = [rho; phi; s] (eqs. 9, 11, 16; body frame).
   // The class is kept; the caller keeps delta within the class (see plusMinimal).
-  Quadric plus(const Vector9d& delta) const;
+  QuadricModel plus(const Vector9d& delta) const;
   // pi [-] pi' = [log(T'^-1 T)^vee; D^-1(S - S')] (eqs. 10, 14, 17). Exact inverse of plus().
-  Vector9d minus(const Quadric& other) const;
+  Vector9d minus(const QuadricModel& other) const;
   // The same through the class's minimal vector (Table II): plus(B delta), B^+ minus(other).
-  Quadric plusMinimal(const Eigen::VectorXd& delta) const;
-  Eigen::VectorXd minusMinimal(const Quadric& other) const;
+  QuadricModel plusMinimal(const Eigen::VectorXd& delta) const;
+  Eigen::VectorXd minusMinimal(const QuadricModel& other) const;
 
  private:
   QuadricClass class_ = QuadricClass::kSphere;
@@ -75,6 +77,6 @@ class Quadric {
 
 // The measurement prediction h(T_WC, pi) = (T_WC^-1 T_WQ, S) (eq. 19): the quadric in the camera
 // frame.
-Quadric predictMeasurement(const Eigen::Isometry3d& T_world_camera, const Quadric& quadric_world);
+QuadricModel predictMeasurement(const Eigen::Isometry3d& T_world_camera, const QuadricModel& quadric_world);
 
 }  // namespace quadric_slam

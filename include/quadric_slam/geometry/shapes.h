@@ -37,29 +37,29 @@ struct ConeShape {
 };
 
 // Shape of a quadric; throws std::invalid_argument when the quadric is of another class.
-PlaneShape planeShape(const Quadric& quadric);
-SphereShape sphereShape(const Quadric& quadric);
-CylinderShape cylinderShape(const Quadric& quadric);
-ConeShape coneShape(const Quadric& quadric);
+PlaneShape planeShape(const QuadricModel& quadric);
+SphereShape sphereShape(const QuadricModel& quadric);
+CylinderShape cylinderShape(const QuadricModel& quadric);
+ConeShape coneShape(const QuadricModel& quadric);
 
-// Quadric of a shape; directions need not be unit (they are normalised) but must be nonzero;
+// The QuadricModel of a shape; directions need not be unit (they are normalised) but must be nonzero;
 // radius > 0; half_angle in (0, pi/2). Throws std::invalid_argument naming the bad field.
-Quadric quadricFromShape(const PlaneShape& shape);
-Quadric quadricFromShape(const SphereShape& shape);
-Quadric quadricFromShape(const CylinderShape& shape);
-Quadric quadricFromShape(const ConeShape& shape);
+QuadricModel quadricFromShape(const PlaneShape& shape);
+QuadricModel quadricFromShape(const SphereShape& shape);
+QuadricModel quadricFromShape(const CylinderShape& shape);
+QuadricModel quadricFromShape(const ConeShape& shape);
 
 // QuadricSurface.msg `shape`: plane [nx ny nz d], sphere [cx cy cz r], cylinder [px py pz dx dy dz
 // r], cone [ax ay az dx dy dz half_angle], general [].
-std::vector<double> shapeVector(const Quadric& quadric);
+std::vector<double> shapeVector(const QuadricModel& quadric);
 // Throws std::invalid_argument for the wrong length or for kGeneral (its shape is empty).
-Quadric quadricFromShapeVector(QuadricClass quadric_class, const std::vector<double>& shape);
+QuadricModel quadricFromShapeVector(QuadricClass quadric_class, const std::vector<double>& shape);
 
 // Map schema keys (MapFileQuadric::shape): plane {normal, offset}; sphere {center, radius};
 // cylinder {point, axis, radius}; cone {apex, axis, half_angle}; general {} (scalars: length 1).
-std::map<std::string, std::vector<double>> shapeMap(const Quadric& quadric);
+std::map<std::string, std::vector<double>> shapeMap(const QuadricModel& quadric);
 // Throws std::invalid_argument naming a missing key or a wrong length.
-Quadric quadricFromShapeMap(QuadricClass quadric_class,
+QuadricModel quadricFromShapeMap(QuadricClass quadric_class,
                             const std::map<std::string, std::vector<double>>& shape);
 
 // A proper rotation whose column `column` (0 = x, 2 = z) is the unit vector `direction`.

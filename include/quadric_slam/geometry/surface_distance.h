@@ -10,16 +10,16 @@ namespace quadric_slam {
 
 // f(p) = (S p_Q)^T D(sigma_1..3) (S p_Q) + sigma_4 with p_Q = T_frame_quadric^-1 p: the algebraic
 // value p~^T Q p~ of eqs. 2 and 4 (zero on the surface).
-double algebraicDistance(const Quadric& quadric, const Eigen::Vector3d& p);
+double algebraicDistance(const QuadricModel& quadric, const Eigen::Vector3d& p);
 // grad f in the quadric's frame: 2 R S D(sigma_1..3) S p_Q.
-Eigen::Vector3d algebraicGradient(const Quadric& quadric, const Eigen::Vector3d& p);
+Eigen::Vector3d algebraicGradient(const QuadricModel& quadric, const Eigen::Vector3d& p);
 // First-order geometric distance |f| / |grad f| (infinite where grad f = 0 off the surface; 0 on
 // it). Exact to first order near a surface whose f vanishes to first order; for the double plane
 // (alpha x)^2 = 0, f vanishes to second order and this gives half the true distance.
-double firstOrderDistance(const Quadric& quadric, const Eigen::Vector3d& p);
+double firstOrderDistance(const QuadricModel& quadric, const Eigen::Vector3d& p);
 // Exact Euclidean distance for plane, sphere, cylinder and (double) cone; throws
 // std::invalid_argument for kGeneral.
-double exactDistance(const Quadric& quadric, const Eigen::Vector3d& p);
+double exactDistance(const QuadricModel& quadric, const Eigen::Vector3d& p);
 
 // Projection of a point onto the surface. Exact closest point for plane, sphere, cylinder and
 // cone; for a general quadric, Newton steps along the gradient p <- p - f grad f / |grad f|^2
@@ -34,7 +34,7 @@ class SurfaceProjector {
   SurfaceProjector();
   explicit SurfaceProjector(const Params& params);
   // Throws std::invalid_argument when a general quadric's projection does not converge.
-  Eigen::Vector3d project(const Quadric& quadric, const Eigen::Vector3d& p) const;
+  Eigen::Vector3d project(const QuadricModel& quadric, const Eigen::Vector3d& p) const;
 
  private:
   Params params_;

@@ -38,10 +38,10 @@ Matrix6d adSE3(const Vector6d& xi);
 Eigen::MatrixXd minimalAdjoint(QuadricClass quadric_class, const Eigen::Isometry3d& G);
 
 // z re-expressed by the member of its symmetry orbit closest to `reference` (same surface).
-Quadric alignToReference(const Quadric& z, const Quadric& reference);
+QuadricModel alignToReference(const QuadricModel& z, const QuadricModel& reference);
 
 // Surface difference in the class's minimal space: B^+ (a [-] alignToReference(b, a)).
 // Zero whenever a and b describe the same surface.
-Eigen::VectorXd surfaceMinus(const Quadric& a, const Quadric& b);
+Eigen::VectorXd surfaceMinus(const QuadricModel& a, const QuadricModel& b);
 
 }  // namespace quadric_slam

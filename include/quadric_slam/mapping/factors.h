@@ -40,13 +40,13 @@ Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& covariance, const char* w
 //   dr/d(quadric tangent [dq; ds]) = [L N, L M B^+_s],   dr/d(camera tangent) = -L N Ad_{h^-1}.
 class QuadricObservationCost : public ceres::CostFunction {
  public:
-  QuadricObservationCost(const Quadric& z_camera, const Eigen::MatrixXd& sqrt_information);
-  static ceres::CostFunction* Create(const Quadric& z_camera, const Eigen::MatrixXd& covariance);
+  QuadricObservationCost(const QuadricModel& z_camera, const Eigen::MatrixXd& sqrt_information);
+  static ceres::CostFunction* Create(const QuadricModel& z_camera, const Eigen::MatrixXd& covariance);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
  private:
-  Quadric z_;
+  QuadricModel z_;
   Eigen::Isometry3d T_quadric_camera_z_;  // z^-1
   Eigen::MatrixXd sqrt_information_;      // L (k x k)
   Eigen::MatrixXd basis_pinv_;            // B^+ (k x 9)

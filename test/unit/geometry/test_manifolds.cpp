@@ -66,7 +66,7 @@ void expectQuadricManifold(QuadricClass c, int seed) {
   QuadricManifold m(c);
   EXPECT_EQ(m.TangentSize(), minimalDimension(c));
   for (int trial = 0; trial < 10; ++trial) {
-    const Quadric q = test::randomQuadric(c, rng);
+    const QuadricModel q = test::randomQuadric(c, rng);
     Eigen::VectorXd x(10);
     quadricToParameters(q, x.data());
     expectManifoldConsistent(m, x, rng);
@@ -97,13 +97,13 @@ TEST(QuadricManifold, TangentMovesFollowTableTwo) {
   // A cylinder's tangent (rho1, rho2, phi1, phi2, alpha) never moves along or rotates about its
   // own axis; a plane's (rho1, phi2, phi3) only moves along its normal or tilts it.
   std::mt19937 rng(8);
-  const Quadric cyl = test::randomQuadric(QuadricClass::kCylinder, rng);
+  const QuadricModel cyl = test::randomQuadric(QuadricClass::kCylinder, rng);
   const Eigen::Vector3d axis = cyl.pose().linear().col(2);
   Eigen::VectorXd d(5);
   d << 0.2, -0.1, 0, 0, 0;  // translation only
-  const Quadric moved = cyl.plusMinimal(d);
+  const QuadricModel moved = cyl.plusMinimal(d);
   EXPECT_NEAR((moved.pose().translation() - cyl.pose().translation()).dot(axis), 0, 1e-12);
-  const Quadric plane = test::randomQuadric(QuadricClass::kPlane, rng);
+  const QuadricModel plane = test::randomQuadric(QuadricClass::kPlane, rng);
   Eigen::VectorXd dp(3);
   dp << 0.3, 0, 0;
   const Eigen::Vector3d shift =

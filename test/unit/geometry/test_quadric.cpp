@@ -12,7 +12,7 @@ namespace {
 
 // Points on the canonical surface, mapped by T_WQ: solve f = 0 along random rays from a point
 // where f < 0 (inside/between sheets) to one where f > 0.
-std::vector<Eigen::Vector3d> surfacePoints(const Quadric& q, std::mt19937& rng, int n) {
+std::vector<Eigen::Vector3d> surfacePoints(const QuadricModel& q, std::mt19937& rng, int n) {
   std::vector<Eigen::Vector3d> out;
   for (int tries = 0; tries < 200 * n && static_cast<int>(out.size()) < n; ++tries) {
     Eigen::Vector3d a = q.pose() * test::randomVector(rng, 3.0);
@@ -38,9 +38,9 @@ std::vector<Eigen::Vector3d> surfacePoints(const Quadric& q, std::mt19937& rng, 
 void expectDecomposeRoundTrip(QuadricClass c, const Eigen::Vector4d& signature, int seed) {
   std::mt19937 rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
-    const Quadric q = test::randomQuadric(c, rng, signature);
+    const QuadricModel q = test::randomQuadric(c, rng, signature);
     const double projective = test::uniform(rng, 0.1, 10.0) * (trial % 2 ? -1.0 : 1.0);
-    const Quadric d = Quadric::fromMatrix(projective * q.matrix(), c);
+    const QuadricModel d = QuadricModel::fromMatrix(projective * q.matrix(), c);
     EXPECT_EQ(d.quadricClass(), c);
     EXPECT_EQ(d.signature(), q.signature()) << "trial " << trial;
     EXPECT_LT((test::normalizedMatrix(d.matrix()) - test::normalizedMatrix(q.matrix()))
@@ -90,9 +90,9 @@ TEST(GeneralQuadric, DecomposeRoundTripHyperbolicCylinder) {
   expectDecomposeRoundTrip(QuadricClass::kGeneral, Eigen::Vector4d(1, -1, 0, -1), 10);
 }
 
-TEST(Quadric, ComposeFollowsEquationFive) {
+TEST(QuadricModel, ComposeFollowsEquationFive) {
   // Paper, Table I row 2: T = I, S = diag(1, 0.5, 2), ellipsoid x^2 + y^2/4 + 4 z^2 = 1.
-  const Quadric q(QuadricClass::kGeneral, Eigen::Isometry3d::Identity(), Eigen::Vector3d(1, 0.5, 2),
+  const QuadricModel q(QuadricClass::kGeneral, Eigen::Isometry3d::Identity(), Eigen::Vector3d(1, 0.5, 2),
                   Eigen::Vector4d(1, 1, 1, -1));
   EXPECT_LT((q.matrix() - Eigen::Vector4d(1, 0.25, 4, -1).asDiagonal().toDenseMatrix()).norm(),
             1e-15);
@@ -101,18 +101,18 @@ TEST(Quadric, ComposeFollowsEquationFive) {
   // A plane: quadric x = 0 through (1, 2, 3) with normal along world z.
   Eigen::Matrix3d R;
   R << 0, 1, 0, 0, 0, 1, 1, 0, 0;  // quadric x -> world z
-  const Quadric plane(QuadricClass::kPlane, makeIsometry(R, Eigen::Vector3d(1, 2, 3)),
+  const QuadricModel plane(QuadricClass::kPlane, makeIsometry(R, Eigen::Vector3d(1, 2, 3)),
                       Eigen::Vector3d::Ones());
   EXPECT_NEAR(algebraicDistance(plane, Eigen::Vector3d(-5, 7, 3)), 0, 1e-12);
   EXPECT_NEAR(algebraicDistance(plane, Eigen::Vector3d(-5, 7, 4)), 1, 1e-12);  // (alpha x)^2
 }
 
-TEST(Quadric, PaperTableOneRowThree) {
+TEST(QuadricModel, PaperTableOneRowThree) {
   // T_WQ = [1 0 0 0; 0 0 1 3; 0 -1 0 0; 0 0 0 1], S = diag(1, 0.5, 2): the ellipsoid with
   // semi-axes (1, 2, 0.5) along quadric x, y, z = world x, -z, y, centred at (0, 3, 0).
   Eigen::Matrix4d T;
   T << 1, 0, 0, 0, 0, 0, 1, 3, 0, -1, 0, 0, 0, 0, 0, 1;
-  const Quadric q(QuadricClass::kGeneral, Eigen::Isometry3d(T), Eigen::Vector3d(1, 0.5, 2),
+  const QuadricModel q(QuadricClass::kGeneral, Eigen::Isometry3d(T), Eigen::Vector3d(1, 0.5, 2),
                   Eigen::Vector4d(1, 1, 1, -1));
   for (const Eigen::Vector3d& p : {Eigen::Vector3d(1, 3, 0), Eigen::Vector3d(0, 3, -2),
                                    Eigen::Vector3d(0, 3, 2), Eigen::Vector3d(0, 3.5, 0)}) {
@@ -123,13 +123,13 @@ TEST(Quadric, PaperTableOneRowThree) {
   EXPECT_NEAR(centre.dot(q.matrix() * centre), -1, 1e-12);
 }
 
-TEST(Quadric, MeasurementTransformsLikeAQuadric) {
+TEST(QuadricModel, MeasurementTransformsLikeAQuadric) {
   // eq. 19: h(T_WC, pi) = (T_WC^-1 T_WQ, S), and then Q_C = T_WC^T Q_W T_WC.
   std::mt19937 rng(12);
   for (QuadricClass c : kAllQuadricClasses) {
-    const Quadric q = test::randomQuadric(c, rng);
+    const QuadricModel q = test::randomQuadric(c, rng);
     const Eigen::Isometry3d T_WC = test::randomPose(rng);
-    const Quadric h = predictMeasurement(T_WC, q);
+    const QuadricModel h = predictMeasurement(T_WC, q);
     EXPECT_LT((h.pose().matrix() - (T_WC.inverse() * q.pose()).matrix()).norm(), 1e-12);
     EXPECT_EQ(h.scale(), q.scale());
     const Eigen::Matrix4d expected = T_WC.matrix().transpose() * q.matrix() * T_WC.matrix();
@@ -137,73 +137,73 @@ TEST(Quadric, MeasurementTransformsLikeAQuadric) {
   }
 }
 
-TEST(Quadric, PlusMinusRoundTrip) {
+TEST(QuadricModel, PlusMinusRoundTrip) {
   std::mt19937 rng(13);
   for (QuadricClass c : kAllQuadricClasses) {
     for (int trial = 0; trial < 10; ++trial) {
-      const Quadric q = test::randomQuadric(c, rng);
+      const QuadricModel q = test::randomQuadric(c, rng);
       Vector9d d;
       for (int i = 0; i < 9; ++i)
         d[i] = test::uniform(rng, -0.5, 0.5);
-      const Quadric general =
-          Quadric(QuadricClass::kGeneral, q.pose(), q.scale() * 2.0, Eigen::Vector4d(1, 1, 1, -1));
+      const QuadricModel general =
+          QuadricModel(QuadricClass::kGeneral, q.pose(), q.scale() * 2.0, Eigen::Vector4d(1, 1, 1, -1));
       EXPECT_LT((general.plus(d).minus(general) - d).norm(), 1e-10);  // eqs. 10-17
       const int k = minimalDimension(c);
       Eigen::VectorXd m(k);
       for (int i = 0; i < k; ++i)
         m[i] = test::uniform(rng, -0.3, 0.3);
-      const Quadric moved = q.plusMinimal(m);
+      const QuadricModel moved = q.plusMinimal(m);
       EXPECT_LT((moved.minusMinimal(q) - m).norm(), 1e-10) << toString(c);
       EXPECT_EQ(moved.quadricClass(), c);
       // the class's ties survive [+]
-      EXPECT_NO_THROW(Quadric(c, moved.pose(), moved.scale()));
+      EXPECT_NO_THROW(QuadricModel(c, moved.pose(), moved.scale()));
     }
   }
 }
 
-TEST(Quadric, DecomposeRejectsDegenerateAndUnsupported) {
+TEST(QuadricModel, DecomposeRejectsDegenerateAndUnsupported) {
   Eigen::Matrix4d Q = Eigen::Matrix4d::Zero();
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
   Q = Eigen::Vector4d(1, 1, 1, -1).asDiagonal();
   Q(0, 1) = 0.5;  // not symmetric
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
   Q = Eigen::Vector4d(1, 1, 1, 1).asDiagonal();  // x^2 + y^2 + z^2 + 1 = 0: no real points
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
   Q = Eigen::Vector4d(1, -1, 0, 0).asDiagonal();  // x^2 - y^2 = 0: pair of planes
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
   Q = Eigen::Vector4d(1, 1, 1, 0).asDiagonal();  // a single point
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
   Q = Eigen::Matrix4d::Zero();  // paraboloid x^2 + y^2 - z = 0
   Q(0, 0) = Q(1, 1) = 1;
   Q(2, 3) = Q(3, 2) = -0.5;
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
   Q = Eigen::Matrix4d::Zero();  // single plane in linear form: z = 0
   Q(2, 3) = Q(3, 2) = 0.5;
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kGeneral), std::invalid_argument);
   Q = Eigen::Vector4d(1, 0.25, 4, -1).asDiagonal();  // ellipsoid is not a sphere
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kSphere), std::invalid_argument);
-  EXPECT_NO_THROW(Quadric::fromMatrix(Q, QuadricClass::kGeneral));
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kSphere), std::invalid_argument);
+  EXPECT_NO_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kGeneral));
   Q = Eigen::Vector4d(1, 1, 0, -1).asDiagonal();  // a cylinder is not a cone or a plane
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kCone), std::invalid_argument);
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kPlane), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kCone), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kPlane), std::invalid_argument);
   Q = Eigen::Vector4d(1, 0, 0, -1).asDiagonal();  // x^2 = 1: two parallel planes
-  EXPECT_THROW(Quadric::fromMatrix(Q, QuadricClass::kPlane), std::invalid_argument);
+  EXPECT_THROW(QuadricModel::fromMatrix(Q, QuadricClass::kPlane), std::invalid_argument);
 }
 
-TEST(Quadric, ConstructorValidates) {
+TEST(QuadricModel, ConstructorValidates) {
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
-  EXPECT_THROW(Quadric(QuadricClass::kSphere, I, Eigen::Vector3d(1, 2, 1)), std::invalid_argument);
-  EXPECT_THROW(Quadric(QuadricClass::kCylinder, I, Eigen::Vector3d(2, 2, 3)),
+  EXPECT_THROW(QuadricModel(QuadricClass::kSphere, I, Eigen::Vector3d(1, 2, 1)), std::invalid_argument);
+  EXPECT_THROW(QuadricModel(QuadricClass::kCylinder, I, Eigen::Vector3d(2, 2, 3)),
                std::invalid_argument);
-  EXPECT_THROW(Quadric(QuadricClass::kSphere, I, Eigen::Vector3d(-1, -1, -1)),
+  EXPECT_THROW(QuadricModel(QuadricClass::kSphere, I, Eigen::Vector3d(-1, -1, -1)),
                std::invalid_argument);
   EXPECT_THROW(
-      Quadric(QuadricClass::kCone, I, Eigen::Vector3d(1, 1, 1), Eigen::Vector4d(1, 1, 1, -1)),
+      QuadricModel(QuadricClass::kCone, I, Eigen::Vector3d(1, 1, 1), Eigen::Vector4d(1, 1, 1, -1)),
       std::invalid_argument);
   EXPECT_THROW(
-      Quadric(QuadricClass::kGeneral, I, Eigen::Vector3d(1, 1, 1), Eigen::Vector4d(1, 0.5, 1, -1)),
+      QuadricModel(QuadricClass::kGeneral, I, Eigen::Vector3d(1, 1, 1), Eigen::Vector4d(1, 0.5, 1, -1)),
       std::invalid_argument);
-  EXPECT_NO_THROW(Quadric(QuadricClass::kCylinder, I, Eigen::Vector3d(2, 2, 1)));
+  EXPECT_NO_THROW(QuadricModel(QuadricClass::kCylinder, I, Eigen::Vector3d(2, 2, 1)));
 }
 
 }  // namespace

@@ -14,7 +14,7 @@ namespace {
 
 TEST(PlaneShape, FollowsMessageConventions) {
   // n = quadric x axis, n.p = offset for every point of the plane.
-  const Quadric q = quadricFromShape(PlaneShape{Eigen::Vector3d(0, 0, 2), 1.5});
+  const QuadricModel q = quadricFromShape(PlaneShape{Eigen::Vector3d(0, 0, 2), 1.5});
   EXPECT_LT((q.pose().linear().col(0) - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
   EXPECT_NEAR(algebraicDistance(q, Eigen::Vector3d(3, -2, 1.5)), 0, 1e-12);
   EXPECT_NEAR(exactDistance(q, Eigen::Vector3d(3, -2, 2.5)), 1.0, 1e-12);
@@ -26,14 +26,14 @@ TEST(PlaneShape, FollowsMessageConventions) {
 }
 
 TEST(SphereShape, FollowsMessageConventions) {
-  const Quadric q = quadricFromShape(SphereShape{Eigen::Vector3d(1, 2, 3), 0.5});
+  const QuadricModel q = quadricFromShape(SphereShape{Eigen::Vector3d(1, 2, 3), 0.5});
   EXPECT_LT((q.scale() - Eigen::Vector3d::Constant(2.0)).norm(), 1e-12);  // S = 1/r
   EXPECT_NEAR(algebraicDistance(q, Eigen::Vector3d(1, 2.5, 3)), 0, 1e-12);
   EXPECT_NEAR(sphereShape(q).radius, 0.5, 1e-12);
 }
 
 TEST(CylinderShape, FollowsMessageConventions) {
-  const Quadric q =
+  const QuadricModel q =
       quadricFromShape(CylinderShape{Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 3, 0), 0.25});
   EXPECT_LT((q.pose().linear().col(2) - Eigen::Vector3d::UnitY()).norm(), 1e-12);  // axis = z
   EXPECT_LT((q.scale() - Eigen::Vector3d(4, 4, 1)).norm(), 1e-12);
@@ -44,7 +44,7 @@ TEST(CylinderShape, FollowsMessageConventions) {
 
 TEST(ConeShape, FollowsMessageConventions) {
   const double half = 0.3;
-  const Quadric q =
+  const QuadricModel q =
       quadricFromShape(ConeShape{Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, -1), half});
   EXPECT_LT((q.pose().linear().col(2) + Eigen::Vector3d::UnitZ()).norm(), 1e-12);
   EXPECT_NEAR(q.scale().x(), 1 / std::tan(half), 1e-12);  // S = 1/tan(half_angle)
@@ -59,11 +59,11 @@ TEST(ConeShape, FollowsMessageConventions) {
 void expectShapeRoundTrips(QuadricClass c, int seed) {
   std::mt19937 rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
-    const Quadric q = test::randomQuadric(c, rng);
+    const QuadricModel q = test::randomQuadric(c, rng);
     const std::vector<double> v = shapeVector(q);
     EXPECT_EQ(v.size(), c == QuadricClass::kPlane || c == QuadricClass::kSphere ? 4u : 7u);
-    const Quadric from_vector = quadricFromShapeVector(c, v);
-    const Quadric from_map = quadricFromShapeMap(c, shapeMap(q));
+    const QuadricModel from_vector = quadricFromShapeVector(c, v);
+    const QuadricModel from_map = quadricFromShapeMap(c, shapeMap(q));
     // Same surface (frames may differ by the class's symmetry).
     EXPECT_LT(surfaceMinus(from_vector, q).norm(), 1e-9);
     EXPECT_LT(surfaceMinus(from_map, q).norm(), 1e-9);
@@ -107,7 +107,7 @@ TEST(Shapes, MapKeysFollowTheSchema) {
   EXPECT_EQ(cone.at("apex").size(), 3u);
   EXPECT_EQ(cone.at("axis").size(), 3u);
   EXPECT_EQ(cone.at("half_angle").size(), 1u);
-  EXPECT_TRUE(shapeMap(Quadric(QuadricClass::kGeneral, Eigen::Isometry3d::Identity(),
+  EXPECT_TRUE(shapeMap(QuadricModel(QuadricClass::kGeneral, Eigen::Isometry3d::Identity(),
                                Eigen::Vector3d(1, 2, 3), Eigen::Vector4d(1, 1, 1, -1)))
                   .empty());
 }

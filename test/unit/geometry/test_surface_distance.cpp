@@ -29,15 +29,15 @@ double bruteForceConeDistance(const ConeShape& cone, const Eigen::Vector3d& p) {
 }
 
 TEST(SurfaceDistance, ExactDistancesOfClassesOfRevolution) {
-  const Quadric sphere = quadricFromShape(SphereShape{Eigen::Vector3d(1, 1, 1), 2.0});
+  const QuadricModel sphere = quadricFromShape(SphereShape{Eigen::Vector3d(1, 1, 1), 2.0});
   EXPECT_NEAR(exactDistance(sphere, Eigen::Vector3d(1, 1, 4)), 1.0, 1e-12);
   EXPECT_NEAR(exactDistance(sphere, Eigen::Vector3d(1, 1, 1.5)), 1.5, 1e-12);
-  const Quadric cyl =
+  const QuadricModel cyl =
       quadricFromShape(CylinderShape{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), 1.0});
   EXPECT_NEAR(exactDistance(cyl, Eigen::Vector3d(50, 3, 0)), 2.0, 1e-12);
   std::mt19937 rng(81);
   const ConeShape cone{Eigen::Vector3d(0.5, -1, 2), Eigen::Vector3d(1, 2, -1).normalized(), 0.5};
-  const Quadric q = quadricFromShape(cone);
+  const QuadricModel q = quadricFromShape(cone);
   for (int i = 0; i < 20; ++i) {
     const Eigen::Vector3d p = test::randomVector(rng, 3.0);
     EXPECT_NEAR(exactDistance(q, p), bruteForceConeDistance(cone, p), 2e-3 * (1 + p.norm()));
@@ -47,7 +47,7 @@ TEST(SurfaceDistance, ExactDistancesOfClassesOfRevolution) {
 TEST(SurfaceDistance, FirstOrderApproximatesExactNearTheSurface) {
   std::mt19937 rng(82);
   for (QuadricClass c : {QuadricClass::kSphere, QuadricClass::kCylinder, QuadricClass::kCone}) {
-    const Quadric q = test::randomQuadric(c, rng);
+    const QuadricModel q = test::randomQuadric(c, rng);
     SurfaceProjector projector;
     for (int i = 0; i < 20; ++i) {
       const Eigen::Vector3d on = projector.project(q, q.pose() * test::randomVector(rng, 2.0));
@@ -59,7 +59,7 @@ TEST(SurfaceDistance, FirstOrderApproximatesExactNearTheSurface) {
     }
   }
   // The double plane (alpha x)^2 vanishes to second order: |f|/|grad f| is half the distance.
-  const Quadric plane = quadricFromShape(PlaneShape{Eigen::Vector3d::UnitZ(), 0});
+  const QuadricModel plane = quadricFromShape(PlaneShape{Eigen::Vector3d::UnitZ(), 0});
   EXPECT_NEAR(firstOrderDistance(plane, Eigen::Vector3d(1, 2, 0.4)), 0.2, 1e-12);
   EXPECT_NEAR(exactDistance(plane, Eigen::Vector3d(1, 2, 0.4)), 0.4, 1e-12);
 }
@@ -69,7 +69,7 @@ TEST(SurfaceProjector, ProjectsOntoTheClosestSurfacePoint) {
   SurfaceProjector projector;
   for (QuadricClass c : {QuadricClass::kPlane, QuadricClass::kSphere, QuadricClass::kCylinder,
                          QuadricClass::kCone}) {
-    const Quadric q = test::randomQuadric(c, rng);
+    const QuadricModel q = test::randomQuadric(c, rng);
     for (int i = 0; i < 20; ++i) {
       const Eigen::Vector3d p = test::randomVector(rng, 3.0);
       const Eigen::Vector3d s = projector.project(q, p);
@@ -84,7 +84,7 @@ TEST(SurfaceProjector, GeneralQuadricsConvergeToTheSurface) {
   SurfaceProjector projector;
   for (const Eigen::Vector4d& sig : {Eigen::Vector4d(1, 1, 1, -1), Eigen::Vector4d(1, 1, -1, -1),
                                      Eigen::Vector4d(1, 1, -1, 1)}) {
-    const Quadric q = test::randomQuadric(QuadricClass::kGeneral, rng, sig);
+    const QuadricModel q = test::randomQuadric(QuadricClass::kGeneral, rng, sig);
     for (int i = 0; i < 20; ++i) {
       const Eigen::Vector3d p = q.pose() * test::randomVector(rng, 1.0);
       const Eigen::Vector3d s = projector.project(q, p);

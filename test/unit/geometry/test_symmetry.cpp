@@ -11,9 +11,9 @@ namespace {
 void expectSurfaceMinusInvariant(QuadricClass c, int seed) {
   std::mt19937 rng(seed);
   for (int trial = 0; trial < 20; ++trial) {
-    const Quadric a = test::randomQuadric(c, rng);
+    const QuadricModel a = test::randomQuadric(c, rng);
     const Eigen::Isometry3d G = test::randomSymmetry(c, rng);
-    const Quadric same(c, a.pose() * G, a.scale(), a.signature());
+    const QuadricModel same(c, a.pose() * G, a.scale(), a.signature());
     // Same surface (same Q), different frame: zero difference.
     ASSERT_LT((same.matrix() - a.matrix()).cwiseAbs().maxCoeff(), 1e-9);
     EXPECT_LT(surfaceMinus(a, same).norm(), 1e-9) << toString(c) << " trial " << trial;
@@ -21,8 +21,8 @@ void expectSurfaceMinusInvariant(QuadricClass c, int seed) {
     Eigen::VectorXd d(minimalDimension(c));
     for (int i = 0; i < d.size(); ++i)
       d[i] = test::uniform(rng, -0.2, 0.2);
-    const Quadric b = a.plusMinimal(d);
-    const Quadric b_other(c, b.pose() * test::randomSymmetry(c, rng), b.scale(), b.signature());
+    const QuadricModel b = a.plusMinimal(d);
+    const QuadricModel b_other(c, b.pose() * test::randomSymmetry(c, rng), b.scale(), b.signature());
     EXPECT_LT((surfaceMinus(a, b) - surfaceMinus(a, b_other)).norm(), 1e-9);
     // ... and it recovers the minimal displacement that made b from a, up to sign.
     EXPECT_LT((surfaceMinus(b, a) - d).norm(), 1e-9) << toString(c) << " trial " << trial;

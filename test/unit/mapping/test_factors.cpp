@@ -32,19 +32,19 @@ Eigen::VectorXd randomVectorX(std::mt19937& rng, int n, double sigma) {
 // the class's minimal space, re-expressed in a random frame of the same surface (its symmetry
 // orbit) so that the cost must not depend on the frame the front-end happened to choose. The
 // covariance in that frame is returned in *covariance (M sigma^2 M^T, M = minimalAdjoint(G^-1)).
-Quadric observe(const Quadric& truth, const Eigen::Isometry3d& T_WC, double sigma,
+QuadricModel observe(const QuadricModel& truth, const Eigen::Isometry3d& T_WC, double sigma,
                 std::mt19937& rng, Eigen::MatrixXd* covariance = nullptr) {
   const QuadricClass c = truth.quadricClass();
   const int k = minimalDimension(c);
-  const Quadric h = predictMeasurement(T_WC, truth);
-  const Quadric noisy = h.plusMinimal(randomVectorX(rng, k, sigma));
+  const QuadricModel h = predictMeasurement(T_WC, truth);
+  const QuadricModel noisy = h.plusMinimal(randomVectorX(rng, k, sigma));
   const Eigen::Isometry3d G = test::randomSymmetry(c, rng);
   if (covariance != nullptr) {
     const Eigen::MatrixXd M = minimalAdjoint(c, G.inverse());
     *covariance = sigma * sigma * M * M.transpose();
     *covariance = 0.5 * (*covariance + covariance->transpose()).eval();
   }
-  return Quadric(c, noisy.pose() * G, noisy.scale(), noisy.signature());
+  return QuadricModel(c, noisy.pose() * G, noisy.scale(), noisy.signature());
 }
 
 Eigen::VectorXd evaluate(const ceres::CostFunction& cost,
@@ -92,15 +92,15 @@ void expectObservationJacobians(QuadricClass c, int seed) {
   PoseManifold pose_manifold;
   QuadricManifold quadric_manifold(c);
   for (int trial = 0; trial < 10; ++trial) {
-    const Quadric truth = test::randomQuadric(c, rng);
+    const QuadricModel truth = test::randomQuadric(c, rng);
     const Eigen::Isometry3d T_WC = test::randomPose(rng);
-    const Quadric z = observe(truth, T_WC, 0.05, rng);
+    const QuadricModel z = observe(truth, T_WC, 0.05, rng);
     const int k = minimalDimension(c);
     Eigen::MatrixXd cov = Eigen::MatrixXd::Random(k, k);
     cov = cov * cov.transpose() * 0.01 + 0.01 * Eigen::MatrixXd::Identity(k, k);
     std::unique_ptr<ceres::CostFunction> cost(QuadricObservationCost::Create(z, cov));
     // Evaluate at a state away from the measurement (nonzero residual).
-    const Quadric state = truth.plusMinimal(randomVectorX(rng, k, 0.2));
+    const QuadricModel state = truth.plusMinimal(randomVectorX(rng, k, 0.2));
     PoseBlock pose;
     QuadricBlock quadric;
     poseToParameters(plus(T_WC, randomVectorX(rng, 6, 0.1)), pose.data());
@@ -165,7 +165,7 @@ TEST(PosePriorFactor, ZeroAtPriorAndWhitened) {
 }
 
 TEST(QuadricObservationCost, RejectsBadCovariance) {
-  const Quadric sphere;
+  const QuadricModel sphere;
   EXPECT_THROW(QuadricObservationCost::Create(sphere, Eigen::MatrixXd::Identity(3, 3)),
                std::invalid_argument);
   EXPECT_THROW(QuadricObservationCost::Create(sphere, -Eigen::MatrixXd::Identity(4, 4)),
@@ -181,7 +181,7 @@ void expectResidualInvariant(QuadricClass c, int seed) {
   std::mt19937 rng(seed);
   const int k = minimalDimension(c);
   for (int trial = 0; trial < 20; ++trial) {
-    const Quadric truth = test::randomQuadric(c, rng);
+    const QuadricModel truth = test::randomQuadric(c, rng);
     const Eigen::Isometry3d T_WC = test::randomPose(rng);
     PoseBlock pose;
     QuadricBlock quadric;
@@ -189,14 +189,14 @@ void expectResidualInvariant(QuadricClass c, int seed) {
     quadricToParameters(truth, quadric.data());
     Eigen::MatrixXd cov = Eigen::MatrixXd::Random(k, k);
     cov = cov * cov.transpose() * 0.01 + 0.001 * Eigen::MatrixXd::Identity(k, k);
-    const Quadric h = predictMeasurement(T_WC, truth);
-    const Quadric h_other(c, h.pose() * test::randomSymmetry(c, rng), h.scale(), h.signature());
+    const QuadricModel h = predictMeasurement(T_WC, truth);
+    const QuadricModel h_other(c, h.pose() * test::randomSymmetry(c, rng), h.scale(), h.signature());
     std::unique_ptr<ceres::CostFunction> exact(QuadricObservationCost::Create(h_other, cov));
     EXPECT_LT(evaluate(*exact, {pose.data(), quadric.data()}).norm(), 1e-9)
         << toString(c) << " trial " << trial;
-    const Quadric z = h.plusMinimal(randomVectorX(rng, k, 0.1));
+    const QuadricModel z = h.plusMinimal(randomVectorX(rng, k, 0.1));
     const Eigen::Isometry3d G0 = test::randomSymmetry(c, rng);
-    const Quadric z_other(c, z.pose() * G0, z.scale(), z.signature());
+    const QuadricModel z_other(c, z.pose() * G0, z.scale(), z.signature());
     const Eigen::MatrixXd M = minimalAdjoint(c, G0.inverse());
     const Eigen::MatrixXd cov_other = M * cov * M.transpose();
     std::unique_ptr<ceres::CostFunction> cost_a(QuadricObservationCost::Create(z, cov));
@@ -257,7 +257,7 @@ void expectSmallProblemConverges(QuadricClass c, int seed) {
   std::mt19937 rng(seed);
   const double sigma = 0.01;
   const int k = minimalDimension(c), n_obs = 12;
-  const Quadric truth = test::randomQuadric(c, rng);
+  const QuadricModel truth = test::randomQuadric(c, rng);
   std::vector<PoseBlock> poses(n_obs);
   QuadricBlock quadric;
   quadricToParameters(truth.plusMinimal(randomVectorX(rng, k, 0.15)), quadric.data());
@@ -269,7 +269,7 @@ void expectSmallProblemConverges(QuadricClass c, int seed) {
     problem.AddParameterBlock(poses[i].data(), kPoseParameterSize, new PoseManifold);
     problem.SetParameterBlockConstant(poses[i].data());
     Eigen::MatrixXd cov;
-    const Quadric z = observe(truth, T_WC, sigma, rng, &cov);
+    const QuadricModel z = observe(truth, T_WC, sigma, rng, &cov);
     problem.AddResidualBlock(QuadricObservationCost::Create(z, cov), nullptr, poses[i].data(),
                              quadric.data());
   }
@@ -279,7 +279,7 @@ void expectSmallProblemConverges(QuadricClass c, int seed) {
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   ASSERT_TRUE(summary.IsSolutionUsable()) << summary.FullReport();
-  const Quadric estimate = quadricFromParameters(quadric.data(), c, truth.signature());
+  const QuadricModel estimate = quadricFromParameters(quadric.data(), c, truth.signature());
   const Eigen::VectorXd error = surfaceMinus(estimate, truth);
   // Each component averages n_obs draws of N(0, sigma^2) (in rotated local frames): 5 sigma /
   // sqrt(n).
@@ -316,7 +316,7 @@ TEST(GeneralFactor, SmallProblemConvergesWithFullRankInformation) {
 struct PointOnEllipsoidResidual {
   explicit PointOnEllipsoidResidual(const Eigen::Vector3d& p) : p_(p) {}
   bool operator()(const double* q, double* residual) const {
-    const Quadric quadric(QuadricClass::kGeneral, poseFromParameters(q),
+    const QuadricModel quadric(QuadricClass::kGeneral, poseFromParameters(q),
                           Eigen::Vector3d(q[7], q[8], q[9]), Eigen::Vector4d(1, 1, 1, -1));
     residual[0] = algebraicDistance(quadric, p_);
     return true;
@@ -329,7 +329,7 @@ TEST(SphereInformation, GeneralFormIsRankDeficientMinimalFormIsNot) {
   // rotation. In the general 9-parameter form J^T J is rank deficient (rank 6: position + three
   // scales); in the sphere's 4-parameter form (rho, alpha) it is full rank.
   std::mt19937 rng(66);
-  const Quadric sphere = test::randomQuadric(QuadricClass::kSphere, rng);
+  const QuadricModel sphere = test::randomQuadric(QuadricClass::kSphere, rng);
   const double r = 1.0 / sphere.scale().x();
   for (QuadricClass form : {QuadricClass::kGeneral, QuadricClass::kSphere}) {
     QuadricBlock block;
@@ -365,25 +365,25 @@ TEST(JointProblem, TenPosesFourQuadricsConvergeWithDogleg) {
                                   .toRotationMatrix();
     truth_poses.push_back(makeIsometry(R, Eigen::Vector3d(0.3 * i, 0.02 * i * i, 1.2)));
   }
-  const std::vector<Quadric> truth_quadrics = {
-      Quadric(QuadricClass::kPlane, makeIsometry(Eigen::Matrix3d::Identity(), {0, 4, 0}),
+  const std::vector<QuadricModel> truth_quadrics = {
+      QuadricModel(QuadricClass::kPlane, makeIsometry(Eigen::Matrix3d::Identity(), {0, 4, 0}),
               Eigen::Vector3d::Ones()),  // wall x = 0 ... rotated below
-      Quadric(QuadricClass::kSphere, makeIsometry(Eigen::Matrix3d::Identity(), {1.0, 3.0, 0.8}),
+      QuadricModel(QuadricClass::kSphere, makeIsometry(Eigen::Matrix3d::Identity(), {1.0, 3.0, 0.8}),
               Eigen::Vector3d::Constant(1 / 0.3)),
-      Quadric(QuadricClass::kCylinder, makeIsometry(Eigen::Matrix3d::Identity(), {2.0, 3.5, 0.0}),
+      QuadricModel(QuadricClass::kCylinder, makeIsometry(Eigen::Matrix3d::Identity(), {2.0, 3.5, 0.0}),
               Eigen::Vector3d(1 / 0.2, 1 / 0.2, 1)),
-      Quadric(QuadricClass::kCone,
+      QuadricModel(QuadricClass::kCone,
               makeIsometry(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix(),
                            {3.0, 3.0, 1.5}),
               Eigen::Vector3d(1 / std::tan(0.4), 1 / std::tan(0.4), 1))};
-  std::vector<Quadric> quadrics = truth_quadrics;
+  std::vector<QuadricModel> quadrics = truth_quadrics;
   // The plane: y = 4 (normal = world y).
   quadrics[0] =
-      Quadric(QuadricClass::kPlane,
+      QuadricModel(QuadricClass::kPlane,
               makeIsometry(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
                            {0, 4, 0}),
               Eigen::Vector3d::Ones());
-  const std::vector<Quadric> truth = {quadrics[0], truth_quadrics[1], truth_quadrics[2],
+  const std::vector<QuadricModel> truth = {quadrics[0], truth_quadrics[1], truth_quadrics[2],
                                       truth_quadrics[3]};
 
   const double sigma_odom_t = 0.01, sigma_odom_r = 0.005, sigma_obs = 0.01;
@@ -421,7 +421,7 @@ TEST(JointProblem, TenPosesFourQuadricsConvergeWithDogleg) {
     problem.AddParameterBlock(landmarks[j].data(), kQuadricParameterSize, new QuadricManifold(c));
     for (int i = 0; i < n_poses; ++i) {
       Eigen::MatrixXd cov;
-      const Quadric z = observe(truth[j], truth_poses[i], sigma_obs, rng, &cov);
+      const QuadricModel z = observe(truth[j], truth_poses[i], sigma_obs, rng, &cov);
       problem.AddResidualBlock(QuadricObservationCost::Create(z, cov), nullptr, poses[i].data(),
                                landmarks[j].data());
     }
@@ -439,7 +439,7 @@ TEST(JointProblem, TenPosesFourQuadricsConvergeWithDogleg) {
       *max_r = std::max(*max_r, e.tail<3>().norm());
     }
     for (size_t j = 0; j < truth.size(); ++j) {
-      const Quadric est =
+      const QuadricModel est =
           quadricFromParameters(landmarks[j].data(), truth[j].quadricClass(), truth[j].signature());
       *max_q = std::max(*max_q, surfaceMinus(est, truth[j]).cwiseAbs().maxCoeff());
     }
