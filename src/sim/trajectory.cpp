@@ -52,7 +52,7 @@ std::string formatTumPose(const StampedPose& pose) {
   const Eigen::Vector3d t = pose.T_world_camera.translation();
   const Eigen::Quaterniond q(pose.T_world_camera.rotation());
   char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), "%.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f", pose.stamp,
+  std::snprintf(buffer, sizeof(buffer), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f", pose.stamp,
                 t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   return buffer;
 }
