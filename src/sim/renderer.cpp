@@ -65,58 +65,76 @@ bool Renderer::pixelBox(const Eigen::Vector3d& c, double r, PixelBox* box) const
 void Renderer::castRows(const Eigen::Isometry3d& T_world_camera,
                         const std::vector<int>& candidates, const std::vector<PixelBox>& boxes,
                         int row_begin, int row_step, RenderedFrame* frame) const {
-  const Eigen::Matrix3d R = T_world_camera.linear();
-  const Eigen::Vector3d origin = T_world_camera.translation();
+  // Per candidate surface, the camera centre and the pixel rays in the surface frame: the ray of
+  // pixel (u, v) is base(v) + u * step, with unit optical z so that the ray parameter is the depth.
+  struct Candidate {
+    int index;
+    PixelBox box;
+    Eigen::Vector3d origin, step, base_u0, base_v;
+  };
+  std::vector<Candidate> all;
+  for (int i : candidates) {
+    const Eigen::Isometry3d T_surface_camera = surfaces_[i].inversePose() * T_world_camera;
+    const Eigen::Matrix3d M = T_surface_camera.linear();
+    Candidate c;
+    c.index = i;
+    c.box = boxes[i];
+    c.origin = T_surface_camera.translation();
+    c.step = M.col(0) / camera_.fx;
+    c.base_u0 = M.col(2) - camera_.cx / camera_.fx * M.col(0);
+    c.base_v = M.col(1) / camera_.fy;
+    all.push_back(c);
+  }
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const Eigen::Vector3d background = 255.0 * background_;
-  std::vector<int> row_candidates;
+  const cv::Vec3b background_pixel(cv::saturate_cast<uchar>(background.x()),
+                                   cv::saturate_cast<uchar>(background.y()),
+                                   cv::saturate_cast<uchar>(background.z()));
+  std::vector<Candidate> row;
   for (int v = row_begin; v < camera_.height; v += row_step) {
-    row_candidates.clear();
-    for (int i : candidates) {
-      if (v >= boxes[i].v0 && v <= boxes[i].v1)
-        row_candidates.push_back(i);
+    row.clear();
+    for (const Candidate& c : all) {
+      if (v >= c.box.v0 && v <= c.box.v1) {
+        row.push_back(c);
+        row.back().base_u0 += (v - camera_.cy) * c.base_v;
+      }
     }
     float* depth = frame->depth_true.ptr<float>(v);
     float* cosine = frame->cos_incidence.ptr<float>(v);
     cv::Vec3b* rgb = frame->rgb.ptr<cv::Vec3b>(v);
     std::uint16_t* label = frame->labels.ptr<std::uint16_t>(v);
-    const double y = (v - camera_.cy) / camera_.fy;
     for (int u = 0; u < camera_.width; ++u) {
-      // Direction with unit optical z: the ray parameter t is the depth.
-      const Eigen::Vector3d ray_camera((u - camera_.cx) / camera_.fx, y, 1.0);
-      const Eigen::Vector3d direction = R * ray_camera;
       double best = std::numeric_limits<double>::infinity();
-      int hit = -1;
-      Eigen::Vector3d hit_normal, hit_point;
-      for (int i : row_candidates) {
-        if (u < boxes[i].u0 || u > boxes[i].u1)
+      const Candidate* hit = nullptr;
+      for (const Candidate& c : row) {
+        if (u < c.box.u0 || u > c.box.u1)
           continue;
         double t;
-        Eigen::Vector3d normal, point;
-        if (surfaces_[i].intersect(origin, direction, params_.near_clip, best, &t, &normal,
-                                   &point)) {
+        if (surfaces_[c.index].intersectLocal(c.origin, c.base_u0 + u * c.step, params_.near_clip,
+                                              best, &t)) {
           best = t;
-          hit = i;
-          hit_normal = normal;
-          hit_point = point;
+          hit = &c;
         }
       }
-      if (hit < 0) {
+      if (!hit) {
         depth[u] = nan;
         cosine[u] = 0.0f;
-        rgb[u] = cv::Vec3b(static_cast<uchar>(background.x()), static_cast<uchar>(background.y()),
-                           static_cast<uchar>(background.z()));
+        rgb[u] = background_pixel;
         label[u] = 0;
         continue;
       }
-      const double c = std::abs(hit_normal.dot(direction)) / direction.norm();
+      const Surface& surface = surfaces_[hit->index];
+      const Eigen::Vector3d direction = hit->base_u0 + u * hit->step;
+      const Eigen::Vector3d point = hit->origin + best * direction;
+      const Eigen::Vector3d normal = surface.normalLocal(point);
+      const double c = std::abs(normal.dot(direction)) / (normal.norm() * direction.norm());
       depth[u] = static_cast<float>(best);
       cosine[u] = static_cast<float>(c);
       const Eigen::Vector3d colour =
-          255.0 * (params_.ambient + (1.0 - params_.ambient) * c) * surfaces_[hit].albedo(hit_point);
+          255.0 * (params_.ambient + (1.0 - params_.ambient) * c) * surface.albedo(point);
       rgb[u] = cv::Vec3b(cv::saturate_cast<uchar>(colour.x()), cv::saturate_cast<uchar>(colour.y()),
                          cv::saturate_cast<uchar>(colour.z()));
-      label[u] = static_cast<std::uint16_t>(surfaces_[hit].id());
+      label[u] = static_cast<std::uint16_t>(surface.id());
     }
   }
 }

@@ -110,18 +110,34 @@ bool Surface::intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& di
                         Eigen::Vector3d* point_local) const {
   const Eigen::Vector3d o = T_surface_world_ * origin;
   const Eigen::Vector3d d = T_surface_world_.linear() * direction;
-  Eigen::Vector3d n_local;
-  if (!intersectLocal(o, d, t_min, t_max, t, &n_local))
+  if (!intersectLocal(o, d, t_min, t_max, t))
     return false;
+  const Eigen::Vector3d p = o + *t * d;
   if (normal_world)
-    *normal_world = (T_world_surface_.linear() * n_local).normalized();
+    *normal_world = (T_world_surface_.linear() * normalLocal(p)).normalized();
   if (point_local)
-    *point_local = o + *t * d;
+    *point_local = p;
   return true;
 }
 
+Eigen::Vector3d Surface::normalLocal(const Eigen::Vector3d& p) const {
+  switch (kind_) {
+    case SurfaceKind::kRectangle:
+    case SurfaceKind::kDisc:
+      return Eigen::Vector3d::UnitX();
+    case SurfaceKind::kSphere:
+    case SurfaceKind::kEllipsoid:
+      return p.cwiseQuotient(dims_.cwiseProduct(dims_));
+    case SurfaceKind::kCylinder:
+      return Eigen::Vector3d(p.x(), p.y(), 0.0);
+    case SurfaceKind::kCone:
+      return Eigen::Vector3d(p.x(), p.y(), -dims_.x() * dims_.x() * p.z());
+  }
+  return Eigen::Vector3d::UnitX();
+}
+
 bool Surface::intersectLocal(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min,
-                             double t_max, double* t, Eigen::Vector3d* n) const {
+                             double t_max, double* t) const {
   switch (kind_) {
     case SurfaceKind::kRectangle:
     case SurfaceKind::kDisc: {
@@ -137,7 +153,6 @@ bool Surface::intersectLocal(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
       if (!inside)
         return false;
       *t = tt;
-      *n = Eigen::Vector3d::UnitX();
       return true;
     }
     case SurfaceKind::kSphere:
@@ -149,9 +164,7 @@ bool Surface::intersectLocal(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
         return false;
       for (double tt : {t0, t1}) {
         if (tt > t_min && tt < t_max) {
-          const Eigen::Vector3d p = o + tt * d;
           *t = tt;
-          *n = p.cwiseQuotient(dims_.cwiseProduct(dims_));
           return true;
         }
       }
@@ -170,7 +183,6 @@ bool Surface::intersectLocal(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
         if (std::abs(p.z()) > h)
           continue;
         *t = tt;
-        *n = Eigen::Vector3d(p.x(), p.y(), 0.0);
         return true;
       }
       return false;
@@ -190,7 +202,6 @@ bool Surface::intersectLocal(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
         if (p.z() < dims_.y() || p.z() > dims_.z())
           continue;
         *t = tt;
-        *n = Eigen::Vector3d(p.x(), p.y(), -k * p.z());
         return true;
       }
       return false;
@@ -210,7 +221,12 @@ Eigen::Vector3d Surface::albedo(const Eigen::Vector3d& point_local) const {
                         static_cast<long>(std::floor(p.z()));
     return (parity & 1) ? material_.colour2 : material_.colour;
   }
-  const double w = 0.65 * valueNoise(p) + 0.35 * valueNoise(4.0 * p + Eigen::Vector3d(7, 3, 1));
+  // Smooth value noise plus a fine, uninterpolated grain (one hash) at a quarter of the cell.
+  const Eigen::Vector3d fine = 4.0 * p;
+  const double grain = lattice(static_cast<int>(std::floor(fine.x())),
+                               static_cast<int>(std::floor(fine.y())),
+                               static_cast<int>(std::floor(fine.z())));
+  const double w = 0.75 * valueNoise(p) + 0.25 * grain;
   return (1.0 - w) * material_.colour + w * material_.colour2;
 }
 

@@ -41,6 +41,13 @@ class Surface {
                  double t_max, double* t, Eigen::Vector3d* normal_world,
                  Eigen::Vector3d* point_local) const;
 
+  // The same in the surface frame (hot path of the renderer): only the ray parameter.
+  bool intersectLocal(const Eigen::Vector3d& origin_local, const Eigen::Vector3d& direction_local,
+                      double t_min, double t_max, double* t) const;
+  // Outward (unnormalised) normal at a local point on the surface.
+  Eigen::Vector3d normalLocal(const Eigen::Vector3d& point_local) const;
+  const Eigen::Isometry3d& inversePose() const { return T_surface_world_; }
+
   // RGB colour of the material at a local point (procedural texture, no shading).
   Eigen::Vector3d albedo(const Eigen::Vector3d& point_local) const;
 
@@ -49,9 +56,6 @@ class Surface {
   MapFileQuadric toMapQuadric() const;
 
  private:
-  bool intersectLocal(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double t_min,
-                      double t_max, double* t, Eigen::Vector3d* normal_local) const;
-
   int id_;
   std::string name_;
   SurfaceKind kind_;
