@@ -59,12 +59,12 @@ void optional(const YAML::Node& map, const std::string& key, const std::string& 
     *value = readDouble(map[key], key, where);
 }
 
-const YAML::Node& required(const YAML::Node& map, const std::string& key, const std::string& where,
-                           YAML::Node* out) {
-  *out = map[key];
-  if (!*out)
+// The child node under `key` (returned by value: assigning yaml-cpp nodes would alias them).
+YAML::Node required(const YAML::Node& map, const std::string& key, const std::string& where) {
+  const YAML::Node node = map[key];
+  if (!node)
     throw std::runtime_error(where + "missing key '" + key + "'");
-  return *out;
+  return node;
 }
 
 Eigen::Vector3d readColour(const YAML::Node& node, const std::string& key,
@@ -108,9 +108,7 @@ Material readMaterial(const YAML::Node& node, const std::string& where) {
   if (const YAML::Node texture = node["texture"]) {
     const std::string w = where + "texture: ";
     checkKeys(texture, {"type", "colour", "scale"}, w);
-    YAML::Node type;
-    required(texture, "type", w, &type);
-    const std::string name = type.as<std::string>();
+    const std::string name = required(texture, "type", w).as<std::string>();
     if (name == "none")
       m.texture = Texture::kNone;
     else if (name == "checker")
@@ -133,13 +131,10 @@ PrimitiveSpec readPrimitive(const YAML::Node& node, std::size_t index) {
   if (!node.IsMap())
     throw std::runtime_error(where + "must be a mapping");
   PrimitiveSpec p;
-  YAML::Node value;
-  required(node, "name", where, &value);
-  p.name = value.as<std::string>();
+  p.name = required(node, "name", where).as<std::string>();
   where = "primitives[" + std::to_string(index) + "] (" + p.name + "): ";
-  required(node, "type", where, &value);
   try {
-    p.type = primitiveTypeFromString(value.as<std::string>());
+    p.type = primitiveTypeFromString(required(node, "type", where).as<std::string>());
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(where + "'type': " + e.what());
   }
@@ -165,7 +160,7 @@ PrimitiveSpec readPrimitive(const YAML::Node& node, std::size_t index) {
       break;
   }
   checkKeys(node, keys, where);
-  p.T_world_primitive.translation() = readVec3(required(node, "position", where, &value), "position", where);
+  p.T_world_primitive.translation() = readVec3(required(node, "position", where), "position", where);
   const char* axis_key = p.type == PrimitiveType::kRectangle ? "normal" : "axis";
   if (node["rpy"] && node[axis_key])
     throw std::runtime_error(where + "give either 'rpy' or '" + axis_key + "', not both");
@@ -185,19 +180,19 @@ PrimitiveSpec readPrimitive(const YAML::Node& node, std::size_t index) {
   }
   switch (p.type) {
     case PrimitiveType::kRectangle: {
-      const std::vector<double> s = readList(required(node, "size", where, &value), "size", 2, where);
+      const std::vector<double> s = readList(required(node, "size", where), "size", 2, where);
       p.size = Eigen::Vector3d(0.0, s[0], s[1]);
       break;
     }
     case PrimitiveType::kBox:
-      p.size = readVec3(required(node, "size", where, &value), "size", where);
+      p.size = readVec3(required(node, "size", where), "size", where);
       break;
     case PrimitiveType::kSphere:
-      p.radius = readDouble(required(node, "radius", where, &value), "radius", where);
+      p.radius = readDouble(required(node, "radius", where), "radius", where);
       break;
     case PrimitiveType::kCylinder:
-      p.radius = readDouble(required(node, "radius", where, &value), "radius", where);
-      p.length = readDouble(required(node, "length", where, &value), "length", where);
+      p.radius = readDouble(required(node, "radius", where), "radius", where);
+      p.length = readDouble(required(node, "length", where), "length", where);
       if (node["capped"]) {
         try {
           p.capped = node["capped"].as<bool>();
@@ -207,12 +202,12 @@ PrimitiveSpec readPrimitive(const YAML::Node& node, std::size_t index) {
       }
       break;
     case PrimitiveType::kCone:
-      p.half_angle = readDouble(required(node, "half_angle", where, &value), "half_angle", where);
-      p.z_min = readDouble(required(node, "z_min", where, &value), "z_min", where);
-      p.z_max = readDouble(required(node, "z_max", where, &value), "z_max", where);
+      p.half_angle = readDouble(required(node, "half_angle", where), "half_angle", where);
+      p.z_min = readDouble(required(node, "z_min", where), "z_min", where);
+      p.z_max = readDouble(required(node, "z_max", where), "z_max", where);
       break;
     case PrimitiveType::kEllipsoid:
-      p.radii = readVec3(required(node, "radii", where, &value), "radii", where);
+      p.radii = readVec3(required(node, "radii", where), "radii", where);
       break;
   }
   p.material = readMaterial(node, where);
@@ -314,9 +309,8 @@ Scene parseSceneYaml(const std::string& text) {
                    "depth_noise", "primitives"},
             "");
   Scene scene;
-  YAML::Node value;
   try {
-    scene.name = required(root, "name", "", &value).as<std::string>();
+    scene.name = required(root, "name", "").as<std::string>();
   } catch (const YAML::Exception&) {
     throw std::runtime_error("'name' must be a string");
   }
@@ -325,14 +319,14 @@ Scene parseSceneYaml(const std::string& text) {
   if (root["camera"])
     readCamera(root["camera"], &scene);
   scene.centre_of_interest =
-      readVec3(required(root, "centre_of_interest", "", &value), "centre_of_interest", "");
+      readVec3(required(root, "centre_of_interest", ""), "centre_of_interest", "");
   if (root["background"])
     scene.background = readColour(root["background"], "background", "");
   if (root["handheld"])
     readHandheld(root["handheld"], &scene.handheld);
   if (root["depth_noise"])
     readDepth(root["depth_noise"], &scene.depth);
-  required(root, "primitives", "", &value);
+  const YAML::Node value = required(root, "primitives", "");
   if (!value.IsSequence() || value.size() == 0)
     throw std::runtime_error("'primitives' must be a non-empty list");
   std::set<std::string> names;
