@@ -160,17 +160,17 @@ PrimitiveSpec readPrimitive(const YAML::Node& node, std::size_t index) {
       break;
   }
   checkKeys(node, keys, where);
-  p.T_world_primitive.translation() = readVec3(required(node, "position", where), "position", where);
+  p.T_world_primitive.translation() =
+      readVec3(required(node, "position", where), "position", where);
   const char* axis_key = p.type == PrimitiveType::kRectangle ? "normal" : "axis";
   if (node["rpy"] && node[axis_key])
     throw std::runtime_error(where + "give either 'rpy' or '" + axis_key + "', not both");
   if (node["rpy"]) {
     const Eigen::Vector3d rpy = readVec3(node["rpy"], "rpy", where);
-    p.T_world_primitive.linear() =
-        (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
-         Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
-         Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
-            .toRotationMatrix();
+    p.T_world_primitive.linear() = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+                                    Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+                                       .toRotationMatrix();
   } else if (node[axis_key]) {
     const Eigen::Vector3d axis = readVec3(node[axis_key], axis_key, where);
     if (axis.norm() < 1e-9)
@@ -219,8 +219,9 @@ PrimitiveSpec readPrimitive(const YAML::Node& node, std::size_t index) {
 
 void readHandheld(const YAML::Node& node, HandheldTrajectory::Params* h) {
   const std::string where = "handheld: ";
-  checkKeys(node, {"distance", "height", "azimuth", "sweep", "sweep_period", "wobble",
-                   "gaze_wobble", "roll_wobble", "start_stamp"},
+  checkKeys(node,
+            {"distance", "height", "azimuth", "sweep", "sweep_period", "wobble", "gaze_wobble",
+             "roll_wobble", "start_stamp"},
             where);
   optional(node, "distance", where, &h->distance);
   optional(node, "height", where, &h->height);
@@ -240,9 +241,10 @@ void readHandheld(const YAML::Node& node, HandheldTrajectory::Params* h) {
 
 void readDepth(const YAML::Node& node, KinectDepthModel::Params* d) {
   const std::string where = "depth_noise: ";
-  checkKeys(node, {"min_range", "max_range", "sigma_constant", "sigma_quadratic",
-                   "sigma_reference_depth", "focal_px", "baseline", "disparity_resolution",
-                   "max_incidence", "edge_dropout_px", "edge_jump_ratio", "dropout_probability"},
+  checkKeys(node,
+            {"min_range", "max_range", "sigma_constant", "sigma_quadratic", "sigma_reference_depth",
+             "focal_px", "baseline", "disparity_resolution", "max_incidence", "edge_dropout_px",
+             "edge_jump_ratio", "dropout_probability"},
             where);
   optional(node, "min_range", where, &d->min_range);
   optional(node, "max_range", where, &d->max_range);
@@ -305,8 +307,9 @@ Scene parseSceneYaml(const std::string& text) {
   }
   if (!root || !root.IsMap())
     throw std::runtime_error("scene file must be a YAML mapping");
-  checkKeys(root, {"name", "camera", "centre_of_interest", "background", "handheld",
-                   "depth_noise", "primitives"},
+  checkKeys(root,
+            {"name", "camera", "centre_of_interest", "background", "handheld", "depth_noise",
+             "primitives"},
             "");
   Scene scene;
   try {
@@ -372,25 +375,24 @@ std::string sceneYamlString(const Scene& scene) {
   const HandheldTrajectory::Params& h = scene.handheld;
   out << YAML::Key << "handheld" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "distance" << YAML::Value << h.distance << YAML::Key << "height"
-      << YAML::Value << h.height << YAML::Key << "azimuth" << YAML::Value << h.azimuth
-      << YAML::Key << "sweep" << YAML::Value << h.sweep << YAML::Key << "sweep_period"
-      << YAML::Value << h.sweep_period << YAML::Key << "wobble" << YAML::Value << h.wobble
-      << YAML::Key << "gaze_wobble" << YAML::Value << h.gaze_wobble << YAML::Key << "roll_wobble"
-      << YAML::Value << h.roll_wobble << YAML::Key << "start_stamp" << YAML::Value
-      << h.start_stamp;
+      << YAML::Value << h.height << YAML::Key << "azimuth" << YAML::Value << h.azimuth << YAML::Key
+      << "sweep" << YAML::Value << h.sweep << YAML::Key << "sweep_period" << YAML::Value
+      << h.sweep_period << YAML::Key << "wobble" << YAML::Value << h.wobble << YAML::Key
+      << "gaze_wobble" << YAML::Value << h.gaze_wobble << YAML::Key << "roll_wobble" << YAML::Value
+      << h.roll_wobble << YAML::Key << "start_stamp" << YAML::Value << h.start_stamp;
   out << YAML::EndMap;
   const KinectDepthModel::Params& d = scene.depth;
   out << YAML::Key << "depth_noise" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "min_range" << YAML::Value << d.min_range << YAML::Key << "max_range"
       << YAML::Value << d.max_range << YAML::Key << "sigma_constant" << YAML::Value
       << d.sigma_constant << YAML::Key << "sigma_quadratic" << YAML::Value << d.sigma_quadratic
-      << YAML::Key << "sigma_reference_depth" << YAML::Value << d.sigma_reference_depth
-      << YAML::Key << "focal_px" << YAML::Value << d.focal_px << YAML::Key << "baseline"
-      << YAML::Value << d.baseline << YAML::Key << "disparity_resolution" << YAML::Value
-      << d.disparity_resolution << YAML::Key << "max_incidence" << YAML::Value << d.max_incidence
-      << YAML::Key << "edge_dropout_px" << YAML::Value << d.edge_dropout_px << YAML::Key
-      << "edge_jump_ratio" << YAML::Value << d.edge_jump_ratio << YAML::Key
-      << "dropout_probability" << YAML::Value << d.dropout_probability;
+      << YAML::Key << "sigma_reference_depth" << YAML::Value << d.sigma_reference_depth << YAML::Key
+      << "focal_px" << YAML::Value << d.focal_px << YAML::Key << "baseline" << YAML::Value
+      << d.baseline << YAML::Key << "disparity_resolution" << YAML::Value << d.disparity_resolution
+      << YAML::Key << "max_incidence" << YAML::Value << d.max_incidence << YAML::Key
+      << "edge_dropout_px" << YAML::Value << d.edge_dropout_px << YAML::Key << "edge_jump_ratio"
+      << YAML::Value << d.edge_jump_ratio << YAML::Key << "dropout_probability" << YAML::Value
+      << d.dropout_probability;
   out << YAML::EndMap;
   out << YAML::Key << "primitives" << YAML::Value << YAML::BeginSeq;
   for (const PrimitiveSpec& p : scene.primitives) {

@@ -62,9 +62,9 @@ bool Renderer::pixelBox(const Eigen::Vector3d& c, double r, PixelBox* box) const
   return true;
 }
 
-void Renderer::castRows(const Eigen::Isometry3d& T_world_camera,
-                        const std::vector<int>& candidates, const std::vector<PixelBox>& boxes,
-                        int row_begin, int row_step, RenderedFrame* frame) const {
+void Renderer::castRows(const Eigen::Isometry3d& T_world_camera, const std::vector<int>& candidates,
+                        const std::vector<PixelBox>& boxes, int row_begin, int row_step,
+                        RenderedFrame* frame) const {
   // Per candidate surface, the camera centre and the pixel rays in the surface frame: the ray of
   // pixel (u, v) is base(v) + u * step, with unit optical z so that the ray parameter is the depth.
   struct Candidate {
@@ -153,6 +153,9 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& T_world_camera, std::uin
   std::vector<PixelBox> boxes(surfaces_.size());
   std::vector<int> candidates;
   for (std::size_t i = 0; i < surfaces_.size(); ++i) {
+    // Closed solids' faces turned away from the camera are hidden by their front faces.
+    if (!surfaces_[i].mayBeVisibleFrom(T_world_camera.translation()))
+      continue;
     if (pixelBox(T_camera_world * surfaces_[i].boundCentre(), surfaces_[i].boundRadius(),
                  &boxes[i]))
       candidates.push_back(static_cast<int>(i));
@@ -163,7 +166,8 @@ RenderedFrame Renderer::render(const Eigen::Isometry3d& T_world_camera, std::uin
   } else {
     std::vector<std::thread> workers;
     for (int k = 0; k < threads; ++k)
-      workers.emplace_back([&, k] { castRows(T_world_camera, candidates, boxes, k, threads, &frame); });
+      workers.emplace_back(
+          [&, k] { castRows(T_world_camera, candidates, boxes, k, threads, &frame); });
     for (std::thread& worker : workers)
       worker.join();
   }

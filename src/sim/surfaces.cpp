@@ -41,7 +41,9 @@ std::uint32_t hash3(int x, int y, int z) {
   return h;
 }
 
-double lattice(int x, int y, int z) { return (hash3(x, y, z) & 0xffffu) / 65535.0; }
+double lattice(int x, int y, int z) {
+  return (hash3(x, y, z) & 0xffffu) / 65535.0;
+}
 
 // Smooth value noise in [0, 1] (trilinear interpolation of lattice values with smoothstep).
 double valueNoise(const Eigen::Vector3d& p) {
@@ -67,21 +69,26 @@ Eigen::Isometry3d offsetPose(const Eigen::Isometry3d& parent, const Eigen::Matri
   return parent * local;
 }
 
-Eigen::Matrix3d rotZ(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).matrix(); }
-Eigen::Matrix3d rotY(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).matrix(); }
+Eigen::Matrix3d rotZ(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).matrix();
+}
+Eigen::Matrix3d rotY(double a) {
+  return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitY()).matrix();
+}
 
 }  // namespace
 
 Surface::Surface(int id, std::string name, SurfaceKind kind,
                  const Eigen::Isometry3d& T_world_surface, const Eigen::Vector3d& dims,
-                 const Material& material)
+                 const Material& material, bool closed_face)
     : id_(id),
       name_(std::move(name)),
       kind_(kind),
       T_world_surface_(T_world_surface),
       T_surface_world_(T_world_surface.inverse()),
       dims_(dims),
-      material_(material) {
+      material_(material),
+      closed_face_(closed_face) {
   Eigen::Vector3d centre_local = Eigen::Vector3d::Zero();
   switch (kind_) {
     case SurfaceKind::kRectangle:
@@ -103,6 +110,12 @@ Surface::Surface(int id, std::string name, SurfaceKind kind,
       break;
   }
   bound_centre_ = T_world_surface_ * centre_local;
+}
+
+bool Surface::mayBeVisibleFrom(const Eigen::Vector3d& viewpoint) const {
+  if (!closed_face_)
+    return true;
+  return T_world_surface_.linear().col(0).dot(viewpoint - T_world_surface_.translation()) > 0.0;
 }
 
 bool Surface::intersect(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
@@ -217,15 +230,15 @@ Eigen::Vector3d Surface::albedo(const Eigen::Vector3d& point_local) const {
   if (kind_ == SurfaceKind::kRectangle || kind_ == SurfaceKind::kDisc)
     p.x() = 0.5;  // in-plane pattern, away from a lattice boundary
   if (material_.texture == Texture::kChecker) {
-    const long parity = static_cast<long>(std::floor(p.x())) + static_cast<long>(std::floor(p.y())) +
-                        static_cast<long>(std::floor(p.z()));
+    const long parity = static_cast<long>(std::floor(p.x())) +
+                        static_cast<long>(std::floor(p.y())) + static_cast<long>(std::floor(p.z()));
     return (parity & 1) ? material_.colour2 : material_.colour;
   }
   // Smooth value noise plus a fine, uninterpolated grain (one hash) at a quarter of the cell.
   const Eigen::Vector3d fine = 4.0 * p;
-  const double grain = lattice(static_cast<int>(std::floor(fine.x())),
-                               static_cast<int>(std::floor(fine.y())),
-                               static_cast<int>(std::floor(fine.z())));
+  const double grain =
+      lattice(static_cast<int>(std::floor(fine.x())), static_cast<int>(std::floor(fine.y())),
+              static_cast<int>(std::floor(fine.z())));
   const double w = 0.75 * valueNoise(p) + 0.25 * grain;
   return (1.0 - w) * material_.colour + w * material_.colour2;
 }
@@ -279,8 +292,8 @@ std::vector<Surface> buildSurfaces(const Scene& scene) {
   std::vector<Surface> surfaces;
   int next_id = 1;
   auto add = [&](const std::string& name, SurfaceKind kind, const Eigen::Isometry3d& pose,
-                 const Eigen::Vector3d& dims, const Material& material) {
-    surfaces.emplace_back(next_id++, name, kind, pose, dims, material);
+                 const Eigen::Vector3d& dims, const Material& material, bool closed_face = false) {
+    surfaces.emplace_back(next_id++, name, kind, pose, dims, material, closed_face);
   };
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   for (const PrimitiveSpec& p : scene.primitives) {
@@ -296,17 +309,17 @@ std::vector<Surface> buildSurfaces(const Scene& scene) {
       case PrimitiveType::kBox: {
         const Eigen::Vector3d h = p.size / 2;
         add(p.name + "/+x", SurfaceKind::kRectangle, offsetPose(T, I, {h.x(), 0, 0}),
-            {0, h.y(), h.z()}, p.material);
+            {0, h.y(), h.z()}, p.material, true);
         add(p.name + "/-x", SurfaceKind::kRectangle, offsetPose(T, rotZ(M_PI), {-h.x(), 0, 0}),
-            {0, h.y(), h.z()}, p.material);
+            {0, h.y(), h.z()}, p.material, true);
         add(p.name + "/+y", SurfaceKind::kRectangle, offsetPose(T, rotZ(M_PI / 2), {0, h.y(), 0}),
-            {0, h.x(), h.z()}, p.material);
+            {0, h.x(), h.z()}, p.material, true);
         add(p.name + "/-y", SurfaceKind::kRectangle, offsetPose(T, rotZ(-M_PI / 2), {0, -h.y(), 0}),
-            {0, h.x(), h.z()}, p.material);
+            {0, h.x(), h.z()}, p.material, true);
         add(p.name + "/+z", SurfaceKind::kRectangle, offsetPose(T, rotY(-M_PI / 2), {0, 0, h.z()}),
-            {0, h.y(), h.x()}, p.material);
+            {0, h.y(), h.x()}, p.material, true);
         add(p.name + "/-z", SurfaceKind::kRectangle, offsetPose(T, rotY(M_PI / 2), {0, 0, -h.z()}),
-            {0, h.y(), h.x()}, p.material);
+            {0, h.y(), h.x()}, p.material, true);
         break;
       }
       case PrimitiveType::kSphere:
@@ -315,10 +328,12 @@ std::vector<Surface> buildSurfaces(const Scene& scene) {
       case PrimitiveType::kCylinder:
         add(p.name, SurfaceKind::kCylinder, T, {p.radius, p.radius, p.length / 2}, p.material);
         if (p.capped) {
-          add(p.name + "/+z", SurfaceKind::kDisc, offsetPose(T, rotY(-M_PI / 2), {0, 0, p.length / 2}),
-              {0, p.radius, 0}, p.material);
-          add(p.name + "/-z", SurfaceKind::kDisc, offsetPose(T, rotY(M_PI / 2), {0, 0, -p.length / 2}),
-              {0, p.radius, 0}, p.material);
+          add(p.name + "/+z", SurfaceKind::kDisc,
+              offsetPose(T, rotY(-M_PI / 2), {0, 0, p.length / 2}), {0, p.radius, 0}, p.material,
+              true);
+          add(p.name + "/-z", SurfaceKind::kDisc,
+              offsetPose(T, rotY(M_PI / 2), {0, 0, -p.length / 2}), {0, p.radius, 0}, p.material,
+              true);
         }
         break;
       case PrimitiveType::kCone:
@@ -351,9 +366,9 @@ std::string toString(PrimitiveType type) {
 }
 
 PrimitiveType primitiveTypeFromString(const std::string& name) {
-  for (PrimitiveType type : {PrimitiveType::kRectangle, PrimitiveType::kBox, PrimitiveType::kSphere,
-                             PrimitiveType::kCylinder, PrimitiveType::kCone,
-                             PrimitiveType::kEllipsoid}) {
+  for (PrimitiveType type :
+       {PrimitiveType::kRectangle, PrimitiveType::kBox, PrimitiveType::kSphere,
+        PrimitiveType::kCylinder, PrimitiveType::kCone, PrimitiveType::kEllipsoid}) {
     if (toString(type) == name)
       return type;
   }

@@ -38,8 +38,7 @@ std::vector<StampedPose> readTumTrajectory(const std::string& path) {
     pose.T_world_camera.linear() = q.normalized().toRotationMatrix();
     pose.T_world_camera.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
     if (!poses.empty() && pose.stamp <= poses.back().stamp) {
-      throw std::runtime_error(path + ":" + std::to_string(line_number) +
-                               ": stamps must increase");
+      throw std::runtime_error(path + ":" + std::to_string(line_number) + ": stamps must increase");
     }
     poses.push_back(pose);
   }
@@ -82,8 +81,8 @@ Eigen::Isometry3d interpolatePose(const std::vector<StampedPose>& trajectory, do
   return pose;
 }
 
-std::vector<StampedPose> resampleTrajectory(const std::vector<StampedPose>& trajectory,
-                                            double rate, double seconds) {
+std::vector<StampedPose> resampleTrajectory(const std::vector<StampedPose>& trajectory, double rate,
+                                            double seconds) {
   if (!(rate > 0.0))
     throw std::invalid_argument("resampleTrajectory: rate must be > 0 Hz");
   std::vector<StampedPose> frames;
@@ -180,9 +179,9 @@ std::vector<StampedPose> HandheldTrajectory::generate(const Eigen::Vector3d& cen
     const double azimuth =
         params_.azimuth +
         params_.sweep * (std::sin(2.0 * M_PI * t / params_.sweep_period + phase) - std::sin(phase));
-    Eigen::Vector3d position = centre + Eigen::Vector3d(params_.distance * std::cos(azimuth),
-                                                        params_.distance * std::sin(azimuth),
-                                                        params_.height);
+    Eigen::Vector3d position =
+        centre + Eigen::Vector3d(params_.distance * std::cos(azimuth),
+                                 params_.distance * std::sin(azimuth), params_.height);
     Eigen::Vector3d target = centre;
     for (int i = 0; i < 3; ++i) {
       position[i] += params_.wobble * position_wobble[i](t);
@@ -193,7 +192,8 @@ std::vector<StampedPose> HandheldTrajectory::generate(const Eigen::Vector3d& cen
     pose.T_world_camera = lookAt(position, target);
     pose.T_world_camera.linear() =
         pose.T_world_camera.linear() *
-        Eigen::AngleAxisd(params_.roll_wobble * roll(t), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+        Eigen::AngleAxisd(params_.roll_wobble * roll(t), Eigen::Vector3d::UnitZ())
+            .toRotationMatrix();
     frames.push_back(pose);
   }
   return frames;

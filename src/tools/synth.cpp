@@ -65,7 +65,8 @@ std::string defaultScene() {
   // The package source is the parent of ../shared/data (set by CMake).
   std::string data = QUADRIC_SLAM_SHARED_DATA_DIR;
   const std::string suffix = "/../shared/data";
-  if (data.size() > suffix.size() && data.compare(data.size() - suffix.size(), suffix.size(), suffix) == 0)
+  if (data.size() > suffix.size() &&
+      data.compare(data.size() - suffix.size(), suffix.size(), suffix) == 0)
     return data.substr(0, data.size() - suffix.size()) + "/" + relative;
   return relative;
 }
@@ -231,10 +232,11 @@ int run(int argc, char** argv) {
   qs::writeSceneYaml(scene, o.out + "/scene.yaml");
 
   const double n = static_cast<double>(poses.size());
-  std::printf("timing: %zu frames in %.2f s wall (%.1f frames/s); summed over threads: render "
-              "%.2f s, png %.2f s; bag %.2f s\n",
-              poses.size(), stats.wall_seconds, n / stats.wall_seconds, stats.render_seconds,
-              stats.per_frame_seconds, stats.ordered_seconds);
+  std::printf(
+      "timing: %zu frames in %.2f s wall (%.1f frames/s); summed over threads: render "
+      "%.2f s, png %.2f s; bag %.2f s\n",
+      poses.size(), stats.wall_seconds, n / stats.wall_seconds, stats.render_seconds,
+      stats.per_frame_seconds, stats.ordered_seconds);
   std::printf("coverage (frames with >= 1 labelled pixel with valid depth):\n");
   std::printf("  %3s  %-22s %-10s %7s %7s %12s\n", "id", "name", "class", "frames", "share",
               "mean pixels");

@@ -23,11 +23,12 @@ class KinectDepthModel {
     double sigma_reference_depth = 0.4;  // m
     // Disparity quantisation: depth z = focal * baseline / disparity, disparity measured in steps
     // of disparity_resolution pixels, so the depth step is z^2 * resolution / (focal * baseline).
-    double focal_px = 580.0;              // IR camera focal length (px)
-    double baseline = 0.075;              // projector-camera baseline (m)
-    double disparity_resolution = 0.125;  // px (1/8 px sub-pixel disparity); 0 disables quantisation
-    double max_incidence = 1.309;  // rad (75 deg): more oblique surfaces give no data
-    int edge_dropout_px = 1;       // no data this many pixels on the far side of a discontinuity
+    double focal_px = 580.0;  // IR camera focal length (px)
+    double baseline = 0.075;  // projector-camera baseline (m)
+    double disparity_resolution =
+        0.125;                      // px (1/8 px sub-pixel disparity); 0 disables quantisation
+    double max_incidence = 1.309;   // rad (75 deg): more oblique surfaces give no data
+    int edge_dropout_px = 1;        // no data this many pixels on the far side of a discontinuity
     double edge_jump_ratio = 0.04;  // a neighbour nearer by more than this fraction of z is an edge
     double dropout_probability = 0.002;  // random isolated missing pixels, [0, 1)
 

@@ -25,8 +25,8 @@ struct RenderedFrame {
 class Renderer {
  public:
   struct Params {
-    bool noise = true;       // apply the Kinect model; false: depth = true depth (all ranges)
-    double ambient = 0.35;   // share of the colour that does not depend on the incidence, [0, 1]
+    bool noise = true;        // apply the Kinect model; false: depth = true depth (all ranges)
+    double ambient = 0.35;    // share of the colour that does not depend on the incidence, [0, 1]
     double near_clip = 0.01;  // nearest ray distance considered (m)
     int threads = 1;          // threads over image rows within one frame, >= 1
 

@@ -17,10 +17,10 @@ namespace quadric_slam {
 enum class Texture { kNone, kChecker, kNoise };
 
 struct Material {
-  Eigen::Vector3d colour = Eigen::Vector3d(0.7, 0.7, 0.7);   // RGB in [0, 1]
+  Eigen::Vector3d colour = Eigen::Vector3d(0.7, 0.7, 0.7);  // RGB in [0, 1]
   Texture texture = Texture::kNone;
   Eigen::Vector3d colour2 = Eigen::Vector3d(0.3, 0.3, 0.3);  // second texture colour, RGB [0, 1]
-  double texture_scale = 0.1;                                 // checker cell / noise cell size (m)
+  double texture_scale = 0.1;                                // checker cell / noise cell size (m)
 };
 
 enum class PrimitiveType { kRectangle, kBox, kSphere, kCylinder, kCone, kEllipsoid };
@@ -59,8 +59,8 @@ struct PrimitiveSpec {
 struct Scene {
   std::string name = "scene";  // sequence name (the bag is <name>.bag)
   CameraIntrinsics camera{525.0, 525.0, 319.5, 239.5, 640, 480};
-  double rate = 30.0;  // frames per second (Hz)
-  Eigen::Vector3d centre_of_interest = Eigen::Vector3d::Zero();  // world (m)
+  double rate = 30.0;                                             // frames per second (Hz)
+  Eigen::Vector3d centre_of_interest = Eigen::Vector3d::Zero();   // world (m)
   Eigen::Vector3d background = Eigen::Vector3d(0.55, 0.6, 0.65);  // RGB [0, 1] where nothing is hit
   HandheldTrajectory::Params handheld;
   KinectDepthModel::Params depth;

@@ -23,7 +23,7 @@ class Surface {
   // cylinder (radius, radius, half length); cone (tan(half_angle), z_min, z_max);
   // ellipsoid (semi-axes).
   Surface(int id, std::string name, SurfaceKind kind, const Eigen::Isometry3d& T_world_surface,
-          const Eigen::Vector3d& dims, const Material& material);
+          const Eigen::Vector3d& dims, const Material& material, bool closed_face = false);
 
   int id() const { return id_; }
   const std::string& name() const { return name_; }
@@ -31,6 +31,11 @@ class Surface {
   const Eigen::Isometry3d& pose() const { return T_world_surface_; }
   const Eigen::Vector3d& dims() const { return dims_; }
   const Material& material() const { return material_; }
+  // True for a face of a closed solid (box face, cylinder cap) with its normal (local x)
+  // pointing outwards: invisible from behind its plane, so the renderer may skip it there.
+  bool closedFace() const { return closed_face_; }
+  // False when this is a closed face whose outside is turned away from `viewpoint` (world).
+  bool mayBeVisibleFrom(const Eigen::Vector3d& viewpoint) const;
   // A world-frame sphere enclosing the surface (for the early-out).
   const Eigen::Vector3d& boundCentre() const { return bound_centre_; }
   double boundRadius() const { return bound_radius_; }
@@ -62,6 +67,7 @@ class Surface {
   Eigen::Isometry3d T_world_surface_, T_surface_world_;
   Eigen::Vector3d dims_;
   Material material_;
+  bool closed_face_ = false;
   Eigen::Vector3d bound_centre_;
   double bound_radius_ = 0.0;
 };

@@ -29,8 +29,8 @@ Eigen::Isometry3d interpolatePose(const std::vector<StampedPose>& trajectory, do
 
 // Frames at stamps first_stamp + k / rate for k = 0 .. while k < seconds * rate and the stamp
 // lies within the trajectory.
-std::vector<StampedPose> resampleTrajectory(const std::vector<StampedPose>& trajectory,
-                                            double rate, double seconds);
+std::vector<StampedPose> resampleTrajectory(const std::vector<StampedPose>& trajectory, double rate,
+                                            double seconds);
 
 // Camera looking from `position` at `target` with the image's up as close to world +z as
 // possible (optical frame: z forward, x right, y down).
@@ -43,10 +43,10 @@ Eigen::Isometry3d lookAt(const Eigen::Vector3d& position, const Eigen::Vector3d&
 class HandheldTrajectory {
  public:
   struct Params {
-    double distance = 1.6;      // horizontal distance from the centre of interest (m)
-    double height = 0.8;        // camera height above the centre of interest (m)
-    double azimuth = -1.0;      // direction from the centre to the camera at t = 0 (rad, about z)
-    double sweep = 0.6;         // amplitude of the swing of the azimuth (rad)
+    double distance = 1.6;       // horizontal distance from the centre of interest (m)
+    double height = 0.8;         // camera height above the centre of interest (m)
+    double azimuth = -1.0;       // direction from the centre to the camera at t = 0 (rad, about z)
+    double sweep = 0.6;          // amplitude of the swing of the azimuth (rad)
     double sweep_period = 16.0;  // period of the swing (s)
     double wobble = 0.06;        // amplitude of the position wobble (m)
     double gaze_wobble = 0.08;   // amplitude of the look-at point's wobble (m)

@@ -33,8 +33,8 @@ std::string errorOf(const std::string& text) {
 
 void expectError(const std::string& text, const std::string& needle) {
   const std::string error = errorOf(text);
-  EXPECT_NE(error.find(needle), std::string::npos) << "error '" << error << "' lacks '" << needle
-                                                   << "'";
+  EXPECT_NE(error.find(needle), std::string::npos)
+      << "error '" << error << "' lacks '" << needle << "'";
 }
 
 }  // namespace
@@ -66,8 +66,9 @@ TEST(SceneYaml, ErrorsNameTheBadKey) {
               "duplicate name 'ball'");
   expectError(base + "  - {name: s, type: sphere, position: [0, 0, 1], radius: -1}\n",
               "primitives[1] (s): radius must be > 0");
-  expectError(base + "  - {name: r, type: rectangle, position: [0, 0, 1], size: [1, 2], "
-                     "normal: [0, 0, 1], rpy: [0, 0, 0]}\n",
+  expectError(base +
+                  "  - {name: r, type: rectangle, position: [0, 0, 1], size: [1, 2], "
+                  "normal: [0, 0, 1], rpy: [0, 0, 0]}\n",
               "either 'rpy' or 'normal'");
   expectError(base + "  - {name: r, type: rectangle, position: [0, 0, 1], size: [1, 2, 3]}\n",
               "'size' must be a list of 2");

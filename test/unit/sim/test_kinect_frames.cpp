@@ -26,7 +26,8 @@ TEST(KinectFrames, OpticalFrameLooksAlongTheBodyXAxis) {
 
 TEST(KinectFrames, WorldToKinectComposesBackToTheOpticalPose) {
   Eigen::Isometry3d T_world_optical = Eigen::Isometry3d::Identity();
-  T_world_optical.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).matrix();
+  T_world_optical.linear() =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -2, 0.5).normalized()).matrix();
   T_world_optical.translation() = Eigen::Vector3d(1.2, -0.3, 1.5);
   const Eigen::Isometry3d T_world_kinect = worldToKinect(T_world_optical);
   const std::vector<FixedTransform> c = kinectFrameChain();

@@ -65,8 +65,8 @@ TEST(Renderer, TiltedPlaneDepthMatchesAnalyticDepth) {
       const double analytic = d / n.dot(pixelRay(u, v));  // depth along the optical axis
       worst = std::max(worst, std::abs(frame.depth.at<float>(v, u) - analytic));
       EXPECT_EQ(frame.labels.at<std::uint16_t>(v, u), 1);
-      EXPECT_NEAR(frame.cos_incidence.at<float>(v, u),
-                  std::abs(n.dot(pixelRay(u, v).normalized())), 1e-5);
+      EXPECT_NEAR(frame.cos_incidence.at<float>(v, u), std::abs(n.dot(pixelRay(u, v).normalized())),
+                  1e-5);
     }
   EXPECT_LT(worst, 1e-5);
 }
@@ -147,9 +147,9 @@ TEST(Renderer, LabelsCarryTheIdsOfTheNearestSurface) {
   ASSERT_EQ(surfaces.size(), 7u);
   EXPECT_EQ(surfaces[6].name(), "box/-z");
   const RenderedFrame frame = makeRenderer(scene, false).render(Eigen::Isometry3d::Identity(), 1);
-  EXPECT_EQ(frame.labels.at<std::uint16_t>(120, 160), 1);       // the sphere, centre of image
+  EXPECT_EQ(frame.labels.at<std::uint16_t>(120, 160), 1);   // the sphere, centre of image
   EXPECT_NEAR(frame.depth.at<float>(120, 160), 0.9, 1e-4);  // half a pixel off the centre
-  EXPECT_EQ(frame.labels.at<std::uint16_t>(10, 10), 7);         // the box's -z face behind it
+  EXPECT_EQ(frame.labels.at<std::uint16_t>(10, 10), 7);     // the box's -z face behind it
   EXPECT_NEAR(frame.depth.at<float>(10, 10), 2.5, 1e-5);
   // With the noise model: label 0 wherever the depth has no data, the id elsewhere.
   const RenderedFrame noisy = makeRenderer(scene, true).render(Eigen::Isometry3d::Identity(), 3);

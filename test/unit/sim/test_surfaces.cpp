@@ -82,9 +82,9 @@ TEST(Surfaces, HitPointsLieOnTheMapQuadric) {
       const Eigen::Vector3d dir(random.normal(), random.normal(), random.normal());
       const Eigen::Vector3d origin = surface.boundCentre() + 3.0 * dir.normalized();
       const Eigen::Vector3d target =
-          surface.boundCentre() + surface.boundRadius() * Eigen::Vector3d(random.normal(),
-                                                                          random.normal(),
-                                                                          random.normal()) / 2;
+          surface.boundCentre() +
+          surface.boundRadius() *
+              Eigen::Vector3d(random.normal(), random.normal(), random.normal()) / 2;
       double t;
       Eigen::Vector3d normal, local;
       if (!surface.intersect(origin, target - origin, 1e-6, 1e9, &t, &normal, &local))
@@ -120,12 +120,17 @@ TEST(Surfaces, HitPointsLieOnTheMapQuadric) {
       EXPECT_NEAR(q.scale.x(), 4.0, 1e-12);
     } else if (q.quadric_class == "cylinder") {
       EXPECT_NEAR(q.shape.at("radius")[0], 0.1, 1e-12);
-      EXPECT_NEAR((Eigen::Vector3d(q.shape.at("axis").data()) - Eigen::Vector3d(1, 0.5, 0.2).normalized()).norm(), 0, 1e-9);
+      EXPECT_NEAR(
+          (Eigen::Vector3d(q.shape.at("axis").data()) - Eigen::Vector3d(1, 0.5, 0.2).normalized())
+              .norm(),
+          0, 1e-9);
       EXPECT_EQ(q.scale.z(), 1.0);
     } else if (q.quadric_class == "cone") {
       EXPECT_NEAR(q.shape.at("half_angle")[0], 0.4, 1e-12);
       EXPECT_NEAR(q.scale.x(), 1.0 / std::tan(0.4), 1e-12);
-      EXPECT_NEAR((Eigen::Vector3d(q.shape.at("apex").data()) - Eigen::Vector3d(-0.2, -0.1, 0.8)).norm(), 0, 1e-12);
+      EXPECT_NEAR(
+          (Eigen::Vector3d(q.shape.at("apex").data()) - Eigen::Vector3d(-0.2, -0.1, 0.8)).norm(), 0,
+          1e-12);
     }
   }
 }
@@ -165,4 +170,22 @@ TEST(Surfaces, BadDimensionsNameThePrimitive) {
     EXPECT_NE(std::string(e.what()).find("lamp"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("half_angle"), std::string::npos);
   }
+}
+
+TEST(Surfaces, OnlyClosedSolidFacesAreCulledFromBehind) {
+  const std::vector<Surface> s = buildSurfaces(oneOfEach());
+  EXPECT_FALSE(s[0].closedFace());  // a lone rectangle is two-sided
+  EXPECT_TRUE(s[0].mayBeVisibleFrom(s[0].pose() * Eigen::Vector3d(-1, 0, 0)));
+  for (int i = 1; i <= 6; ++i) {  // box faces: visible from outside only
+    EXPECT_TRUE(s[i].closedFace());
+    EXPECT_TRUE(s[i].mayBeVisibleFrom(s[i].pose() * Eigen::Vector3d(0.5, 0, 0))) << s[i].name();
+    EXPECT_FALSE(s[i].mayBeVisibleFrom(s[i].pose() * Eigen::Vector3d(-0.01, 0, 0))) << s[i].name();
+    // The outward normal points away from the box centre.
+    const Eigen::Vector3d centre(-0.5, 0.1, 2.0);
+    EXPECT_GT(s[i].pose().linear().col(0).dot(s[i].pose().translation() - centre), 0)
+        << s[i].name();
+  }
+  EXPECT_FALSE(s[8].closedFace());  // the cylinder's lateral surface
+  EXPECT_TRUE(s[9].closedFace());   // its caps
+  EXPECT_TRUE(s[10].closedFace());
 }

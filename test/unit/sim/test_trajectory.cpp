@@ -32,8 +32,7 @@ TEST(Trajectory, InterpolatesLinearlyAndSlerps) {
   EXPECT_NEAR(Eigen::AngleAxisd(mid.rotation()).angle(), 0.25, 1e-12);
   EXPECT_THROW(interpolatePose(t, 9.99), std::out_of_range);
   EXPECT_THROW(interpolatePose(t, 11.01), std::out_of_range);
-  EXPECT_NEAR((interpolatePose(t, 11.0).translation() - Eigen::Vector3d(1, 2, 3)).norm(), 0,
-              1e-12);
+  EXPECT_NEAR((interpolatePose(t, 11.0).translation() - Eigen::Vector3d(1, 2, 3)).norm(), 0, 1e-12);
 }
 
 TEST(Trajectory, ResamplesAt30HzFromTheFirstStamp) {
@@ -98,8 +97,8 @@ TEST(Trajectory, HandheldMotionIsSeededSmoothAndLooksAtTheCentre) {
   for (std::size_t k = 0; k < a.size(); ++k) {
     EXPECT_NEAR(a[k].stamp, p.start_stamp + k / 30.0, 1e-6);
     EXPECT_TRUE(a[k].T_world_camera.isApprox(b[k].T_world_camera, 1e-15));
-    differs = std::max(differs, (a[k].T_world_camera.translation() -
-                                 c[k].T_world_camera.translation()).norm());
+    differs = std::max(
+        differs, (a[k].T_world_camera.translation() - c[k].T_world_camera.translation()).norm());
     // The optical axis passes near the centre of interest.
     const Eigen::Vector3d to_centre = centre - a[k].T_world_camera.translation();
     const Eigen::Vector3d axis = a[k].T_world_camera.linear().col(2);
