@@ -37,8 +37,12 @@ std::vector<StampedPose> readTumTrajectory(const std::string& path) {
     pose.stamp = v[0];
     pose.T_world_camera.linear() = q.normalized().toRotationMatrix();
     pose.T_world_camera.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
-    if (!poses.empty() && pose.stamp <= poses.back().stamp) {
-      throw std::runtime_error(path + ":" + std::to_string(line_number) + ": stamps must increase");
+    // The official files repeat a stamp now and then (4-decimal rounding): keep the first.
+    if (!poses.empty() && pose.stamp == poses.back().stamp)
+      continue;
+    if (!poses.empty() && pose.stamp < poses.back().stamp) {
+      throw std::runtime_error(path + ":" + std::to_string(line_number) +
+                               ": stamps must not decrease");
     }
     poses.push_back(pose);
   }

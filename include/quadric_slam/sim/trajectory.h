@@ -17,8 +17,9 @@ struct StampedPose {
 };
 
 // Reads `timestamp tx ty tz qx qy qz qw` lines ('#' comments skipped). Throws std::runtime_error
-// naming the file and line on a malformed line, or when there are fewer than two poses or the
-// stamps do not increase.
+// naming the file and line on a malformed line, a stamp smaller than its predecessor, or fewer
+// than two poses. A line repeating the previous stamp (as in the official fr2_desk file) is
+// skipped.
 std::vector<StampedPose> readTumTrajectory(const std::string& path);
 // One `timestamp tx ty tz qx qy qz qw` line (no newline), stamp with 6 decimals.
 std::string formatTumPose(const StampedPose& pose);
