@@ -61,6 +61,16 @@ double valueNoise(const Eigen::Vector3d& p) {
   return result;
 }
 
+// The same on the lattice plane x = 0 (planar surfaces): four lattice values instead of eight.
+double valueNoise2d(double y, double z) {
+  const int y0 = static_cast<int>(std::floor(y)), z0 = static_cast<int>(std::floor(z));
+  auto smooth = [](double f) { return f * f * (3.0 - 2.0 * f); };
+  const double fy = smooth(y - y0), fz = smooth(z - z0);
+  const double a = lattice(0, y0, z0), b = lattice(0, y0 + 1, z0);
+  const double c = lattice(0, y0, z0 + 1), d = lattice(0, y0 + 1, z0 + 1);
+  return (1 - fz) * ((1 - fy) * a + fy * b) + fz * ((1 - fy) * c + fy * d);
+}
+
 Eigen::Isometry3d offsetPose(const Eigen::Isometry3d& parent, const Eigen::Matrix3d& rotation,
                              const Eigen::Vector3d& translation) {
   Eigen::Isometry3d local = Eigen::Isometry3d::Identity();
@@ -227,7 +237,8 @@ Eigen::Vector3d Surface::albedo(const Eigen::Vector3d& point_local) const {
   if (material_.texture == Texture::kNone)
     return material_.colour;
   Eigen::Vector3d p = point_local / material_.texture_scale;
-  if (kind_ == SurfaceKind::kRectangle || kind_ == SurfaceKind::kDisc)
+  const bool planar = kind_ == SurfaceKind::kRectangle || kind_ == SurfaceKind::kDisc;
+  if (planar)
     p.x() = 0.5;  // in-plane pattern, away from a lattice boundary
   if (material_.texture == Texture::kChecker) {
     const long parity = static_cast<long>(std::floor(p.x())) +
@@ -239,7 +250,8 @@ Eigen::Vector3d Surface::albedo(const Eigen::Vector3d& point_local) const {
   const double grain =
       lattice(static_cast<int>(std::floor(fine.x())), static_cast<int>(std::floor(fine.y())),
               static_cast<int>(std::floor(fine.z())));
-  const double w = 0.75 * valueNoise(p) + 0.25 * grain;
+  const double smooth = planar ? valueNoise2d(p.y(), p.z()) : valueNoise(p);
+  const double w = 0.75 * smooth + 0.25 * grain;
   return (1.0 - w) * material_.colour + w * material_.colour2;
 }
 
