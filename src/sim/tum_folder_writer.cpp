@@ -1,7 +1,6 @@
 #include "quadric_slam/sim/tum_folder_writer.h"
 
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include "quadric_slam/sim/png_writer.h"
 
 #include <cmath>
 #include <cstdio>
@@ -53,25 +52,14 @@ cv::Mat TumFolderWriter::encodeDepth(const cv::Mat& depth_metres) {
 }
 
 void TumFolderWriter::writeFrame(const StampedPose& pose, const RenderedFrame& frame) const {
-  const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, params_.png_compression};
   const std::string stamp = stampString(pose.stamp);
-  auto write = [&](const std::string& path, const cv::Mat& image) {
-    if (!cv::imwrite(path, image, png))
-      throw std::runtime_error("cannot write " + path);
-  };
   if (params_.images) {
-    cv::Mat bgr;
-    cv::cvtColor(frame.rgb, bgr, cv::COLOR_RGB2BGR);
-    write(directory_ + "/rgb/" + stamp + ".png", bgr);
-    write(directory_ + "/depth/" + stamp + ".png", encodeDepth(frame.depth));
+    writePng(directory_ + "/rgb/" + stamp + ".png", frame.rgb, params_.png_compression);
+    writePng(directory_ + "/depth/" + stamp + ".png", encodeDepth(frame.depth),
+             params_.png_compression);
   }
-  if (params_.labels) {
-    // Labels are long runs of one id: run-length coding is as fast and 30x smaller.
-    const std::vector<int> rle = {cv::IMWRITE_PNG_COMPRESSION, params_.png_compression,
-                                  cv::IMWRITE_PNG_STRATEGY, cv::IMWRITE_PNG_STRATEGY_RLE};
-    if (!cv::imwrite(directory_ + "/labels/" + stamp + ".png", frame.labels, rle))
-      throw std::runtime_error("cannot write " + directory_ + "/labels/" + stamp + ".png");
-  }
+  if (params_.labels)
+    writePng(directory_ + "/labels/" + stamp + ".png", frame.labels, params_.png_compression);
 }
 
 void TumFolderWriter::finish(const std::vector<StampedPose>& frames) const {

@@ -14,9 +14,9 @@ namespace quadric_slam {
 class TumFolderWriter {
  public:
   struct Params {
-    bool images = true;       // rgb/, depth/, rgb.txt, depth.txt
-    bool labels = true;       // labels/
-    int png_compression = 1;  // OpenCV IMWRITE_PNG_COMPRESSION, 0 (none, fastest) .. 9
+    bool images = true;                       // rgb/, depth/, rgb.txt, depth.txt
+    bool labels = true;                       // labels/
+    int png_compression = 1;                  // zlib level of the PNG files, 0 (none, fastest) .. 9
     std::string sequence_name = "synthetic";  // named in the header comments
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
