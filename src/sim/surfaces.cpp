@@ -42,7 +42,7 @@ std::uint32_t hash3(int x, int y, int z) {
 }
 
 double lattice(int x, int y, int z) {
-  return (hash3(x, y, z) & 0xffffu) / 65535.0;
+  return (hash3(x, y, z) & 0xffffu) * (1.0 / 65535.0);
 }
 
 // Smooth value noise in [0, 1] (trilinear interpolation of lattice values with smoothstep).
@@ -236,7 +236,7 @@ bool Surface::intersectLocal(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
 Eigen::Vector3d Surface::albedo(const Eigen::Vector3d& point_local) const {
   if (material_.texture == Texture::kNone)
     return material_.colour;
-  Eigen::Vector3d p = point_local / material_.texture_scale;
+  Eigen::Vector3d p = point_local * (1.0 / material_.texture_scale);
   const bool planar = kind_ == SurfaceKind::kRectangle || kind_ == SurfaceKind::kDisc;
   if (planar)
     p.x() = 0.5;  // in-plane pattern, away from a lattice boundary
