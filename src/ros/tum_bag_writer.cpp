@@ -99,7 +99,7 @@ void TumBagWriter::write(const StampedPose& pose, const RenderedFrame& frame) {
   const ros::Time stamp(pose.stamp);
   tf2_msgs::TFMessage tf;
   tf.transforms.push_back(
-      toMsg(kTumWorldFrame, kTumKinectFrame, worldToKinect(pose.T_world_camera), stamp));
+      toMsg(kTumWorldFrame, kTumKinectFrame, worldToKinect(pose.T_world_sensor), stamp));
   for (const FixedTransform& fixed : kinectFrameChain())
     tf.transforms.push_back(toMsg(fixed.parent, fixed.child, fixed.T_parent_child, stamp));
   bag_.write("/tf", stamp, tf);

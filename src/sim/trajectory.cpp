@@ -10,54 +10,22 @@
 
 namespace quadric_slam {
 
-std::vector<StampedPose> readTumTrajectory(const std::string& path) {
-  std::ifstream in(path);
-  if (!in)
-    throw std::runtime_error("cannot open trajectory file " + path);
-  std::vector<StampedPose> poses;
-  std::string line;
-  int line_number = 0;
-  while (std::getline(in, line)) {
-    ++line_number;
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '#')
-      continue;
-    std::istringstream fields(line);
-    double v[8];
-    for (double& x : v) {
-      if (!(fields >> x)) {
-        throw std::runtime_error(path + ":" + std::to_string(line_number) +
-                                 ": expected 'timestamp tx ty tz qx qy qz qw'");
-      }
-    }
-    Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
-    if (q.norm() < 1e-6)
-      throw std::runtime_error(path + ":" + std::to_string(line_number) + ": zero quaternion");
-    StampedPose pose;
-    pose.stamp = v[0];
-    pose.T_world_camera.linear() = q.normalized().toRotationMatrix();
-    pose.T_world_camera.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+Trajectory readDrivingTrajectory(const std::string& path) {
+  const Trajectory read = readTumTrajectory(path);
+  Trajectory poses;
+  for (const StampedPose& pose : read) {
     // The official files repeat a stamp now and then (4-decimal rounding): keep the first.
     if (!poses.empty() && pose.stamp == poses.back().stamp)
       continue;
     if (!poses.empty() && pose.stamp < poses.back().stamp) {
-      throw std::runtime_error(path + ":" + std::to_string(line_number) +
-                               ": stamps must not decrease");
+      throw std::runtime_error(path + ": stamps must not decrease (" + std::to_string(pose.stamp) +
+                               " after " + std::to_string(poses.back().stamp) + ")");
     }
     poses.push_back(pose);
   }
   if (poses.size() < 2)
     throw std::runtime_error(path + ": fewer than two poses");
   return poses;
-}
-
-std::string formatTumPose(const StampedPose& pose) {
-  const Eigen::Vector3d t = pose.T_world_camera.translation();
-  const Eigen::Quaterniond q(pose.T_world_camera.rotation());
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f", pose.stamp,
-                t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-  return buffer;
 }
 
 Eigen::Isometry3d interpolatePose(const std::vector<StampedPose>& trajectory, double stamp) {
@@ -77,11 +45,11 @@ Eigen::Isometry3d interpolatePose(const std::vector<StampedPose>& trajectory, do
   const StampedPose& a = trajectory[hi - 1];
   const StampedPose& b = trajectory[hi];
   const double s = (stamp - a.stamp) / (b.stamp - a.stamp);
-  const Eigen::Quaterniond qa(a.T_world_camera.rotation()), qb(b.T_world_camera.rotation());
+  const Eigen::Quaterniond qa(a.T_world_sensor.rotation()), qb(b.T_world_sensor.rotation());
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   pose.linear() = qa.slerp(s, qb).normalized().toRotationMatrix();
   pose.translation() =
-      (1.0 - s) * a.T_world_camera.translation() + s * b.T_world_camera.translation();
+      (1.0 - s) * a.T_world_sensor.translation() + s * b.T_world_sensor.translation();
   return pose;
 }
 
@@ -193,9 +161,9 @@ std::vector<StampedPose> HandheldTrajectory::generate(const Eigen::Vector3d& cen
     }
     StampedPose pose;
     pose.stamp = params_.start_stamp + t;
-    pose.T_world_camera = lookAt(position, target);
-    pose.T_world_camera.linear() =
-        pose.T_world_camera.linear() *
+    pose.T_world_sensor = lookAt(position, target);
+    pose.T_world_sensor.linear() =
+        pose.T_world_sensor.linear() *
         Eigen::AngleAxisd(params_.roll_wobble * roll(t), Eigen::Vector3d::UnitZ())
             .toRotationMatrix();
     frames.push_back(pose);

@@ -81,9 +81,8 @@ void TumFolderWriter::finish(const std::vector<StampedPose>& frames) const {
     }
   }
   std::ofstream gt = open("groundtruth.txt");
-  gt << "# ground truth trajectory\n" << file << "# timestamp tx ty tz qx qy qz qw\n";
-  for (const StampedPose& f : frames)
-    gt << formatTumPose(f) << "\n";
+  gt << "# ground truth trajectory\n" << file;
+  writeTumTrajectory(frames, gt);
   if (!gt)
     throw std::runtime_error("failed writing " + directory_ + "/groundtruth.txt");
 }

@@ -174,7 +174,7 @@ int run(int argc, char** argv) {
     poses = qs::HandheldTrajectory(scene.handheld)
                 .generate(scene.centre_of_interest, scene.rate, o.seconds, o.seed);
   } else {
-    poses = qs::resampleTrajectory(qs::readTumTrajectory(o.trajectory), scene.rate, o.seconds);
+    poses = qs::resampleTrajectory(qs::readDrivingTrajectory(o.trajectory), scene.rate, o.seconds);
   }
   if (poses.empty())
     throw std::runtime_error("the trajectory gives no frames");

@@ -9,20 +9,15 @@
 #include <string>
 #include <vector>
 
+#include "quadric_slam/io/trajectory_io.h"
+
 namespace quadric_slam {
 
-struct StampedPose {
-  double stamp = 0.0;  // s
-  Eigen::Isometry3d T_world_camera = Eigen::Isometry3d::Identity();
-};
-
-// Reads `timestamp tx ty tz qx qy qz qw` lines ('#' comments skipped). Throws std::runtime_error
-// naming the file and line on a malformed line, a stamp smaller than its predecessor, or fewer
-// than two poses. A line repeating the previous stamp (as in the official fr2_desk file) is
-// skipped.
-std::vector<StampedPose> readTumTrajectory(const std::string& path);
-// One `timestamp tx ty tz qx qy qz qw` line (no newline), stamp with 6 decimals.
-std::string formatTumPose(const StampedPose& pose);
+// A TUM ground-truth file as a driving trajectory (io/trajectory_io.h's reader): a line repeating
+// the previous stamp (as in the official fr2_desk file) is dropped, keeping the first. Throws
+// std::runtime_error naming the file on a stamp smaller than its predecessor or fewer than two
+// poses.
+Trajectory readDrivingTrajectory(const std::string& path);
 
 // Pose at `stamp` (linear in position, slerp in orientation) between the bracketing samples.
 // Throws std::out_of_range when stamp lies outside the trajectory.

@@ -164,10 +164,10 @@ TEST_F(TumBagWriterTest, TfChainComposesToGroundTruthAndStampsAre30Hz) {
     }
     EXPECT_EQ(frame, "/world");
     EXPECT_EQ(depth, 4);  // optical -> rgb_frame -> openni_camera -> kinect -> world
-    EXPECT_NEAR((T_world_optical.translation() - gt[k].T_world_camera.translation()).norm(), 0,
+    EXPECT_NEAR((T_world_optical.translation() - gt[k].T_world_sensor.translation()).norm(), 0,
                 1e-6);
     EXPECT_NEAR(
-        Eigen::AngleAxisd(T_world_optical.linear().transpose() * gt[k].T_world_camera.linear())
+        Eigen::AngleAxisd(T_world_optical.linear().transpose() * gt[k].T_world_sensor.linear())
             .angle(),
         0, 1e-6);
     ++k;

@@ -32,7 +32,7 @@ TEST(SequenceGenerator, DeliversFramesInOrderAndCountsObservations) {
   for (std::size_t k = 0; k < poses.size(); ++k) {
     poses[k].stamp = 1.0 + k / 30.0;
     if (k >= 10)  // turn around: the second ball is seen, the first is not
-      poses[k].T_world_camera.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).matrix();
+      poses[k].T_world_sensor.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY()).matrix();
   }
   SequenceGenerator::Params params;
   params.threads = 3;

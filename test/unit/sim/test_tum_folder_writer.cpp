@@ -41,7 +41,7 @@ TEST(TumFolderWriter, WritesTheTumLayout) {
   std::vector<StampedPose> poses(2);
   poses[0].stamp = 100.0;
   poses[1].stamp = 100.0 + 1.0 / 30;
-  poses[1].T_world_camera.translation() = Eigen::Vector3d(1, 2, 3);
+  poses[1].T_world_sensor.translation() = Eigen::Vector3d(1, 2, 3);
   for (const StampedPose& p : poses)
     writer.writeFrame(p, frame);
   writer.finish(poses);
@@ -71,6 +71,6 @@ TEST(TumFolderWriter, WritesTheTumLayout) {
   const std::vector<StampedPose> gt = readTumTrajectory(dir + "/groundtruth.txt");
   ASSERT_EQ(gt.size(), 2u);
   EXPECT_NEAR(gt[1].stamp, 100.033333, 1e-6);
-  EXPECT_NEAR((gt[1].T_world_camera.translation() - Eigen::Vector3d(1, 2, 3)).norm(), 0, 1e-9);
+  EXPECT_NEAR((gt[1].T_world_sensor.translation() - Eigen::Vector3d(1, 2, 3)).norm(), 0, 1e-9);
   std::filesystem::remove_all(dir);
 }
