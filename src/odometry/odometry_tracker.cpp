@@ -36,8 +36,8 @@ void OdometryTracker::reset() {
   consecutive_lost_ = 0;
 }
 
-void OdometryTracker::setKeyframe(Cloud::ConstPtr cloud, const CameraIntrinsics& intrinsics) {
-  icp_.setReference(std::move(cloud), intrinsics);
+void OdometryTracker::setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics) {
+  icp_.setReference(cloud, intrinsics);
   T_odom_keyframe_ = T_odom_camera_;
   keyframe_covariance_ = covariance_;
 }
@@ -55,18 +55,16 @@ OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_
   return out;
 }
 
-OdometryTracker::Result OdometryTracker::track(Cloud::ConstPtr cloud,
+OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
                                                const CameraIntrinsics& intrinsics, double stamp) {
-  if (!cloud)
-    throw std::invalid_argument("OdometryTracker::track: null cloud");
   std::string problem;
-  if (organizedCloudDecimation(intrinsics, static_cast<int>(cloud->width),
-                               static_cast<int>(cloud->height), &problem) == 0)
+  if (organizedCloudDecimation(intrinsics, static_cast<int>(cloud.width),
+                               static_cast<int>(cloud.height), &problem) == 0)
     throw std::invalid_argument("OdometryTracker::track: " + problem);
-  const bool usable = icp_.usablePoints(*cloud) >= params_.icp.min_correspondences;
+  const auto usable = [&] { return icp_.usablePoints(cloud) >= params_.icp.min_correspondences; };
 
   if (!initialized_) {
-    if (!usable) {
+    if (!usable()) {
       ++consecutive_lost_;
       Result out = output(TrackingStatus::kLost, false);
       out.icp.message = "first frame has too few usable points";
@@ -93,7 +91,7 @@ OdometryTracker::Result OdometryTracker::track(Cloud::ConstPtr cloud,
     prediction = T_odom_camera_ * pose_math::scaleMotion(last_motion_, k);
   }
   const Eigen::Isometry3d T_keyframe_odom = T_odom_keyframe_.inverse();
-  PointToPlaneIcp::Result icp = icp_.align(*cloud, T_keyframe_odom * prediction);
+  PointToPlaneIcp::Result icp = icp_.align(cloud, T_keyframe_odom * prediction);
 
   const Eigen::Isometry3d previous = T_odom_camera_;
   bool new_keyframe = false;
@@ -102,7 +100,7 @@ OdometryTracker::Result OdometryTracker::track(Cloud::ConstPtr cloud,
     ++consecutive_lost_;
     last_motion_ = Eigen::Isometry3d::Identity();
     covariance_ += Matrix6::Identity() * params_.icp.degenerate_variance;
-    if (consecutive_lost_ >= params_.lost_frames_before_new_keyframe && usable) {
+    if (consecutive_lost_ >= params_.lost_frames_before_new_keyframe && usable()) {
       setKeyframe(cloud, intrinsics);
       new_keyframe = true;
     }

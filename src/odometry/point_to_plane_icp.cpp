@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -58,6 +59,8 @@ int organizedCloudDecimation(const CameraIntrinsics& intrinsics, int cloud_width
 void PointToPlaneIcp::Params::validate() const {
   require(pyramid_levels >= 1 && pyramid_levels <= 6, "pyramid_levels", "[1, 6]", pyramid_levels);
   require(finest_stride >= 1 && finest_stride <= 32, "finest_stride", "[1, 32]", finest_stride);
+  require(reference_stride >= 1 && reference_stride <= 16, "reference_stride", "[1, 16]",
+          reference_stride);
   require(max_iterations >= 1 && max_iterations <= 100, "max_iterations", "[1, 100]",
           max_iterations);
   require(max_correspondence_distance > 0 && max_correspondence_distance <= 10,
@@ -88,37 +91,69 @@ PointToPlaneIcp::PointToPlaneIcp(const Params& params) : params_(params) {
   cos_max_normal_angle_ = std::cos(params_.max_normal_angle);
 }
 
-void PointToPlaneIcp::setReference(Cloud::ConstPtr reference, const CameraIntrinsics& intrinsics) {
-  if (!reference)
-    throw std::invalid_argument("PointToPlaneIcp::setReference: null cloud");
+void PointToPlaneIcp::setReference(const Cloud& reference, const CameraIntrinsics& intrinsics) {
   std::string problem;
-  const int d = organizedCloudDecimation(intrinsics, static_cast<int>(reference->width),
-                                         static_cast<int>(reference->height), &problem);
+  const int d = organizedCloudDecimation(intrinsics, static_cast<int>(reference.width),
+                                         static_cast<int>(reference.height), &problem);
   if (d == 0)
     throw std::invalid_argument("PointToPlaneIcp::setReference: " + problem);
-  // Point (col, row) was back-projected from pixel (col * d, row * d) (frame.h).
-  fx_ = static_cast<float>(intrinsics.fx / d);
-  fy_ = static_cast<float>(intrinsics.fy / d);
-  cx_ = static_cast<float>(intrinsics.cx / d);
-  cy_ = static_cast<float>(intrinsics.cy / d);
-  reference_ = std::move(reference);
+  // Cloud point (col, row) was back-projected from pixel (col * d, row * d) (frame.h); grid cell
+  // (i, j) holds cloud point (i * rs, j * rs).
+  const int rs = params_.reference_stride;
+  const double pixels_per_cell = static_cast<double>(d) * rs;
+  fx_ = static_cast<float>(intrinsics.fx / pixels_per_cell);
+  fy_ = static_cast<float>(intrinsics.fy / pixels_per_cell);
+  cx_ = static_cast<float>(intrinsics.cx / pixels_per_cell);
+  cy_ = static_cast<float>(intrinsics.cy / pixels_per_cell);
+  const int w = static_cast<int>(reference.width), h = static_cast<int>(reference.height);
+  ref_w_ = (w + rs - 1) / rs;
+  ref_h_ = (h + rs - 1) / rs;
+  reference_.resize(static_cast<std::size_t>(ref_w_) * ref_h_);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int j = 0; j < ref_h_; ++j) {
+    for (int i = 0; i < ref_w_; ++i) {
+      const pcl::PointNormal& q = reference.points[static_cast<std::size_t>(j * rs) * w + i * rs];
+      RefPoint& r = reference_[static_cast<std::size_t>(j) * ref_w_ + i];
+      const bool ok = std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+                      std::isfinite(q.normal_x) && std::isfinite(q.normal_y) &&
+                      std::isfinite(q.normal_z);
+      r = {q.x, q.y, ok ? q.z : nan, q.normal_x, q.normal_y, q.normal_z};
+    }
+  }
+  has_reference_ = true;
 }
 
-void PointToPlaneIcp::sample(const Cloud& current, int stride) {
-  samples_.clear();
+namespace {
+bool usable(const pcl::PointNormal& q) {
+  return std::isfinite(q.z) && std::isfinite(q.x) && std::isfinite(q.y) &&
+         std::isfinite(q.normal_x) && std::isfinite(q.normal_y) && std::isfinite(q.normal_z);
+}
+}  // namespace
+
+void PointToPlaneIcp::sampleFinest(const Cloud& current) {
+  finest_samples_.clear();
   if (!current.isOrganized() || current.empty())
     return;
+  const int stride = params_.finest_stride;
   const int w = static_cast<int>(current.width), h = static_cast<int>(current.height);
-  samples_.reserve(static_cast<std::size_t>((w / stride + 1) * (h / stride + 1)));
-  for (int row = stride / 2; row < h; row += stride) {
+  finest_samples_.reserve(static_cast<std::size_t>((w / stride + 1) * (h / stride + 1)));
+  for (int row = 0, gv = 0; row < h; row += stride, ++gv) {
     const pcl::PointNormal* line = &current.points[static_cast<std::size_t>(row) * w];
-    for (int col = stride / 2; col < w; col += stride) {
+    for (int col = 0, gu = 0; col < w; col += stride, ++gu) {
       const pcl::PointNormal& q = line[col];
-      if (!std::isfinite(q.z) || !std::isfinite(q.normal_x) || !std::isfinite(q.x) ||
-          !std::isfinite(q.y) || !std::isfinite(q.normal_y) || !std::isfinite(q.normal_z))
-        continue;
-      samples_.push_back({q.getVector3fMap(), q.getNormalVector3fMap()});
+      if (usable(q))
+        finest_samples_.push_back({q.getVector3fMap(), q.getNormalVector3fMap(), gu, gv});
     }
+  }
+}
+
+// Level l keeps the finest-grid samples on every 2^l-th row and column.
+void PointToPlaneIcp::selectLevel(int level) {
+  const int mask = (1 << level) - 1;
+  samples_.clear();
+  for (const Sample& s : finest_samples_) {
+    if ((s.grid_u & mask) == 0 && (s.grid_v & mask) == 0)
+      samples_.push_back(s);
   }
 }
 
@@ -128,13 +163,9 @@ int PointToPlaneIcp::usablePoints(const Cloud& current) const {
   const int stride = params_.finest_stride;
   const int w = static_cast<int>(current.width), h = static_cast<int>(current.height);
   int count = 0;
-  for (int row = stride / 2; row < h; row += stride) {
-    for (int col = stride / 2; col < w; col += stride) {
-      const pcl::PointNormal& q = current.points[static_cast<std::size_t>(row) * w + col];
-      if (std::isfinite(q.z) && std::isfinite(q.normal_x) && std::isfinite(q.x) &&
-          std::isfinite(q.y) && std::isfinite(q.normal_y) && std::isfinite(q.normal_z))
-        ++count;
-    }
+  for (int row = 0; row < h; row += stride) {
+    for (int col = 0; col < w; col += stride)
+      count += usable(current.points[static_cast<std::size_t>(row) * w + col]) ? 1 : 0;
   }
   return count;
 }
@@ -149,7 +180,8 @@ void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance
   eq.count = 0;
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
-  const int w = static_cast<int>(reference_->width), h = static_cast<int>(reference_->height);
+  const int w = ref_w_, h = ref_h_;
+  const float w_f = static_cast<float>(w), h_f = static_cast<float>(h);
   const float max_sq = static_cast<float>(max_distance * max_distance);
   const float min_cos = static_cast<float>(cos_max_normal_angle_);
   const double huber = params_.huber_delta;
@@ -162,15 +194,17 @@ void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance
     if (!(p.z() > 1e-3f))
       continue;
     const float inv_z = 1.0f / p.z();
-    const int col = static_cast<int>(std::floor(fx_ * p.x() * inv_z + cx_ + 0.5f));
-    const int row = static_cast<int>(std::floor(fy_ * p.y() * inv_z + cy_ + 0.5f));
-    if (col < 0 || row < 0 || col >= w || row >= h)
+    // Nearest pixel; the range test comes first so the truncation below rounds non-negatives.
+    const float u = fx_ * p.x() * inv_z + cx_ + 0.5f;
+    const float v = fy_ * p.y() * inv_z + cy_ + 0.5f;
+    if (!(u >= 0.0f && v >= 0.0f && u < w_f && v < h_f))
       continue;
-    const pcl::PointNormal& ref = reference_->points[static_cast<std::size_t>(row) * w + col];
-    if (!std::isfinite(ref.z) || !std::isfinite(ref.normal_x))
+    const int col = static_cast<int>(u), row = static_cast<int>(v);
+    const RefPoint& ref = reference_[static_cast<std::size_t>(row) * w + col];
+    if (!(ref.z == ref.z))  // NaN: no point or no normal there
       continue;
-    const Eigen::Vector3f q = ref.getVector3fMap();
-    const Eigen::Vector3f n = ref.getNormalVector3fMap();
+    const Eigen::Vector3f q(ref.x, ref.y, ref.z);
+    const Eigen::Vector3f n(ref.nx, ref.ny, ref.nz);
     const Eigen::Vector3f diff = p - q;
     if (diff.squaredNorm() > max_sq)
       continue;
@@ -210,7 +244,7 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
   Result result;
   result.T_reference_current = T_reference_current_guess;
   result.covariance = Matrix6::Identity() * params_.degenerate_variance;
-  if (!reference_) {
+  if (!has_reference_) {
     result.message = "no reference cloud";
     return result;
   }
@@ -223,13 +257,16 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
   Normals eq;
   Eigen::SelfAdjointEigenSolver<Matrix6> eigen;
   bool finest_ok = false;
+  sampleFinest(current);
   for (int level = params_.pyramid_levels - 1; level >= 0; --level) {
-    sample(current, params_.finest_stride << level);
+    selectLevel(level);
     const int needed = std::max(12, params_.min_correspondences >> (2 * level));
     if (level == 0)
       result.candidate_points = static_cast<int>(samples_.size());
     const double max_distance =
         params_.max_correspondence_distance * std::pow(params_.coarse_distance_factor, level);
+    // A level with 4^l times fewer points only needs (and reaches) a coarser fixed point.
+    const double convergence_scale = static_cast<double>(1 << (2 * level));
     for (int iteration = 0; iteration < params_.max_iterations; ++iteration) {
       accumulate(T, max_distance, eq);
       if (eq.count < needed)
@@ -272,8 +309,8 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
         }
         result.covariance = cov;
       }
-      if (delta.head<3>().norm() < params_.convergence_translation &&
-          delta.tail<3>().norm() < params_.convergence_rotation)
+      if (delta.head<3>().norm() < params_.convergence_translation * convergence_scale &&
+          delta.tail<3>().norm() < params_.convergence_rotation * convergence_scale)
         break;
     }
   }

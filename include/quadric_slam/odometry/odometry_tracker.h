@@ -52,7 +52,7 @@ class OdometryTracker {
   // of the full-resolution image the cloud was made from (it may be decimated). The first usable
   // frame defines the odom frame (T_odom_camera = identity). Throws std::invalid_argument only when
   // the cloud's size does not fit the intrinsics; bad data otherwise gives status lost.
-  Result track(Cloud::ConstPtr cloud, const CameraIntrinsics& intrinsics, double stamp);
+  Result track(const Cloud& cloud, const CameraIntrinsics& intrinsics, double stamp);
 
   // Forgets the keyframe, pose and velocity: the next usable frame starts a new odom frame.
   void reset();
@@ -62,7 +62,7 @@ class OdometryTracker {
   const Params& params() const { return params_; }
 
  private:
-  void setKeyframe(Cloud::ConstPtr cloud, const CameraIntrinsics& intrinsics);
+  void setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics);
   Result output(TrackingStatus status, bool new_keyframe) const;
 
   Params params_;

@@ -30,7 +30,10 @@ Eigen::Isometry3d groundTruth(int i) {
 
 OdometryTracker::Params sequenceParams() {
   OdometryTracker::Params p;
-  p.icp.finest_stride = 2;  // 320 x 240 clouds: every second point, as 640 x 480 with stride 4
+  // 320 x 240 clouds: every second point and the whole reference, as 640 x 480 with the defaults
+  // (strides 4 and 2).
+  p.icp.finest_stride = 2;
+  p.icp.reference_stride = 1;
   return p;
 }
 
@@ -54,7 +57,7 @@ SequenceRun runSequence(const OdometryTracker::Params& params, int frames, int b
       for (auto& p : cloud->points)
         p.x = p.y = p.z = p.normal_x = std::numeric_limits<float>::quiet_NaN();
     }
-    run.results.push_back(tracker.track(cloud, k, i * kFrameTime));
+    run.results.push_back(tracker.track(*cloud, k, i * kFrameTime));
     run.truth.push_back(T_world_first.inverse() * T_world_camera);
   }
   return run;
@@ -162,20 +165,19 @@ TEST(OdometryTracker, EmptyFirstFramesAreLostThenTrackingStarts) {
   auto empty = pcl::make_shared<pcl::PointCloud<pcl::PointNormal>>(320, 240);
   for (auto& p : empty->points)
     p.x = p.y = p.z = p.normal_x = std::numeric_limits<float>::quiet_NaN();
-  OdometryTracker::Result r = tracker.track(empty, k, 0.0);
+  OdometryTracker::Result r = tracker.track(*empty, k, 0.0);
   EXPECT_EQ(r.status, TrackingStatus::kLost);
   EXPECT_FALSE(tracker.initialized());
-  r = tracker.track(empty, k, 0.1);
+  r = tracker.track(*empty, k, 0.1);
   EXPECT_EQ(r.consecutive_lost, 2);
   auto cloud = synthetic::renderCloud(synthetic::roomScene(), groundTruth(0), k, 2);
-  r = tracker.track(cloud, k, 0.2);
+  r = tracker.track(*cloud, k, 0.2);
   EXPECT_EQ(r.status, TrackingStatus::kOk);
   EXPECT_TRUE(r.new_keyframe);
   EXPECT_TRUE(tracker.initialized());
   // A cloud whose size fits no decimation of the intrinsics is refused.
   auto odd = pcl::make_shared<pcl::PointCloud<pcl::PointNormal>>(300, 240);
-  EXPECT_THROW(tracker.track(odd, k, 0.3), std::invalid_argument);
-  EXPECT_THROW(tracker.track(nullptr, k, 0.3), std::invalid_argument);
+  EXPECT_THROW(tracker.track(*odd, k, 0.3), std::invalid_argument);
 }
 
 // reset() forgets the odom frame: the next frame is the new origin.
@@ -184,12 +186,12 @@ TEST(OdometryTracker, ResetStartsNewOdomFrame) {
   const synthetic::Scene scene = synthetic::roomScene();
   OdometryTracker tracker(sequenceParams());
   for (int i = 0; i < 5; ++i)
-    tracker.track(synthetic::renderCloud(scene, groundTruth(i * 3), k, 2), k, i * kFrameTime);
+    tracker.track(*synthetic::renderCloud(scene, groundTruth(i * 3), k, 2), k, i * kFrameTime);
   EXPECT_FALSE(tracker.pose().isApprox(Eigen::Isometry3d::Identity()));
   tracker.reset();
   EXPECT_FALSE(tracker.initialized());
   const OdometryTracker::Result r =
-      tracker.track(synthetic::renderCloud(scene, groundTruth(30), k, 2), k, 0.0);
+      tracker.track(*synthetic::renderCloud(scene, groundTruth(30), k, 2), k, 0.0);
   EXPECT_EQ(r.status, TrackingStatus::kOk);
   EXPECT_TRUE(r.new_keyframe);
   EXPECT_TRUE(r.T_odom_camera.isApprox(Eigen::Isometry3d::Identity()));
@@ -211,7 +213,7 @@ TEST(OdometryTracker, SingleWallIsDegenerateAndBounded) {
   };
   OdometryTracker::Result r;
   for (int i = 0; i < frames; ++i) {
-    r = tracker.track(synthetic::renderCloud(wall, pose(i), k, 2, 0.0015, 500 + i), k,
+    r = tracker.track(*synthetic::renderCloud(wall, pose(i), k, 2, 0.0015, 500 + i), k,
                       i * kFrameTime);
     if (i > 0) {
       EXPECT_EQ(r.status, TrackingStatus::kDegenerate) << "frame " << i;
