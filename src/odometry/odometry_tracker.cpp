@@ -88,7 +88,8 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   Eigen::Isometry3d prediction = T_odom_camera_;
   if (params_.constant_velocity) {
     const double k = (last_dt_ > 0 && dt > 0) ? std::clamp(dt / last_dt_, 0.0, 3.0) : 1.0;
-    prediction = T_odom_camera_ * pose_math::scaleMotion(last_motion_, k);
+    prediction =
+        pose_math::orthonormalized(T_odom_camera_ * pose_math::scaleMotion(last_motion_, k));
   }
   const Eigen::Isometry3d T_keyframe_odom = T_odom_keyframe_.inverse();
   PointToPlaneIcp::Result icp = icp_.align(cloud, T_keyframe_odom * prediction);
@@ -106,12 +107,12 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     }
   } else {
     consecutive_lost_ = 0;
-    T_odom_camera_ = T_odom_keyframe_ * icp.T_reference_current;
+    T_odom_camera_ = pose_math::orthonormalized(T_odom_keyframe_ * icp.T_reference_current);
     // First-order composition: T_odom_cur = exp(a) T_odom_kf exp(b) T_kf_cur
     //                                     = exp(a + Ad(T_odom_kf) b) T_odom_cur.
     const Matrix6 ad = pose_math::adjoint(T_odom_keyframe_);
     covariance_ = keyframe_covariance_ + ad * icp.covariance * ad.transpose();
-    last_motion_ = previous.inverse() * T_odom_camera_;
+    last_motion_ = pose_math::orthonormalized(previous.inverse() * T_odom_camera_);
     const Eigen::Isometry3d& from_keyframe = icp.T_reference_current;
     if (from_keyframe.translation().norm() > params_.keyframe_translation ||
         pose_math::rotationAngle(from_keyframe) > params_.keyframe_rotation ||

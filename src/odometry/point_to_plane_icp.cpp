@@ -253,7 +253,7 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
     return result;
   }
 
-  Eigen::Isometry3d T = T_reference_current_guess;
+  Eigen::Isometry3d T = pose_math::orthonormalized(T_reference_current_guess);
   Normals eq;
   Eigen::SelfAdjointEigenSolver<Matrix6> eigen;
   bool finest_ok = false;
@@ -295,6 +295,7 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
         finest_ok = true;
         result.correspondences = eq.count;
         result.constrained_dof = constrained;
+        result.eigenvalue_ratio = lambda(5) > 0 ? std::max(0.0, lambda(0)) / lambda(5) : 0.0;
         const double dof = std::max(1, eq.count - 6);
         const double sigma2 = eq.weighted_sq / dof;
         result.rms_residual = std::sqrt(eq.weighted_sq / eq.count);
@@ -337,7 +338,7 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
     result.covariance = Matrix6::Identity() * params_.degenerate_variance;
     return result;
   }
-  result.T_reference_current = T;
+  result.T_reference_current = pose_math::orthonormalized(T);
   if (result.constrained_dof < 6) {
     result.status = TrackingStatus::kDegenerate;
     std::ostringstream why;

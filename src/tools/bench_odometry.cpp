@@ -4,8 +4,10 @@
 // known path. Rendering and normal estimation are not timed.
 //
 // Usage: bench_odometry [--frames N] [--decimation D] [--stride S] [--noise K] [--levels L]
-//   N frames (default 150), D cloud decimation (1), S ICP finest_stride (4),
-//   K depth noise sigma = K z^2 (0.0015 m^-1), L pyramid levels (3).
+//                      [--ref-stride R] [--verbose 1]
+//   N frames (default 150), D cloud decimation (1), S ICP finest_stride (4), R reference_stride
+//   (2), K depth noise sigma = K z^2 (0.0015 m^-1), L pyramid levels (3); --verbose 1 prints every
+//   frame's status and position error.
 #include <time.h>
 
 #include <algorithm>
@@ -53,7 +55,7 @@ double percentile(std::vector<double> v, double q) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int frames = 150, decimation = 1, stride = 4, levels = 3;
+  int frames = 150, decimation = 1, stride = 4, ref_stride = 2, levels = 3, verbose = 0;
   double noise = 0.0015;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
@@ -68,6 +70,10 @@ int main(int argc, char** argv) {
       noise = std::atof(value);
     else if (key == "--levels")
       levels = std::atoi(value);
+    else if (key == "--ref-stride")
+      ref_stride = std::atoi(value);
+    else if (key == "--verbose")
+      verbose = std::atoi(value);
     else {
       std::fprintf(stderr, "unknown option %s\n", key.c_str());
       return 2;
@@ -80,6 +86,7 @@ int main(int argc, char** argv) {
   OdometryTracker::Params params;
   params.icp.finest_stride = stride;
   params.icp.pyramid_levels = levels;
+  params.icp.reference_stride = ref_stride;
   OdometryTracker tracker(params);
   const synthetic::Scene scene = synthetic::roomScene();
   const CameraIntrinsics k = synthetic::vgaIntrinsics();
@@ -106,8 +113,15 @@ int main(int argc, char** argv) {
     keyframes += r.new_keyframe ? 1 : 0;
     last_truth = T_world_first.inverse() * T_world_camera;
     last_estimate = r.T_odom_camera;
-    worst_drift =
-        std::max(worst_drift, (last_estimate.translation() - last_truth.translation()).norm());
+    const double error = (last_estimate.translation() - last_truth.translation()).norm();
+    worst_drift = std::max(worst_drift, error);
+    if (verbose) {
+      std::printf(
+          "frame %3d: %-10s keyframe %d inliers %.3f eigenvalue ratio %.1e iterations %2d "
+          "error %.2f mm\n",
+          i, quadric_slam::toString(r.status), r.new_keyframe ? 1 : 0, r.icp.inlier_fraction,
+          r.icp.eigenvalue_ratio, r.icp.iterations, error * 1e3);
+    }
   }
   const double end_drift = (last_estimate.translation() - last_truth.translation()).norm();
   const double end_rot =

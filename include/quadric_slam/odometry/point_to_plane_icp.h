@@ -93,7 +93,10 @@ class PointToPlaneIcp {
                               // 1 m when depth_noise_weighting)
     int iterations = 0;       // Gauss-Newton iterations over all levels
     int constrained_dof = 0;  // 6 unless degenerate
-    std::string message;      // why the status is not ok (empty when ok)
+    // Smallest over largest eigenvalue of H at the finest level (1: evenly constrained, 0: a free
+    // direction); compared with Params::min_eigenvalue_ratio.
+    double eigenvalue_ratio = 0;
+    std::string message;  // why the status is not ok (empty when ok)
   };
 
   explicit PointToPlaneIcp(const Params& params);

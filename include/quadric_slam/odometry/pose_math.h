@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 
 namespace quadric_slam {
 namespace pose_math {
@@ -43,6 +44,24 @@ inline Matrix6 adjoint(const Eigen::Isometry3d& T) {
   ad.topRightCorner<3, 3>() = skew(T.translation()) * R;
   ad.bottomRightCorner<3, 3>() = R;
   return ad;
+}
+
+// T with its rotation replaced by the nearest rotation matrix (polar decomposition, U V^T).
+// Products and Isometry inverses (which transpose) would otherwise let rounding errors grow without
+// bound along a trajectory: a rotation 0.3% off orthonormal after a few hundred frames is a scale
+// error.
+inline Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& T) {
+  Eigen::Isometry3d out = T;
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(T.linear(),
+                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d R = svd.matrixU() * svd.matrixV().transpose();
+  if (R.determinant() < 0) {  // never for a drifted rotation, but keep it a rotation
+    Eigen::Matrix3d U = svd.matrixU();
+    U.col(2) *= -1;
+    R = U * svd.matrixV().transpose();
+  }
+  out.linear() = R;
+  return out;
 }
 
 // Rotation angle of T (rad, in [0, pi]).
