@@ -127,9 +127,10 @@ int main(int argc, char** argv) {
   const double end_rot =
       quadric_slam::pose_math::rotationAngle(last_estimate.inverse() * last_truth) * 180 / M_PI;
   std::printf(
-      "bench_odometry: %d frames %dx%d (decimation %d), finest_stride %d, %d levels, "
-      "noise %.4f z^2\n",
-      frames, k.width / decimation, k.height / decimation, decimation, stride, levels, noise);
+      "bench_odometry: %d frames %dx%d (decimation %d), finest_stride %d, reference_stride %d, "
+      "%d levels, noise %.4f z^2\n",
+      frames, k.width / decimation, k.height / decimation, decimation, stride, ref_stride, levels,
+      noise);
   std::printf(
       "track() wall time per frame: median %.2f ms, p95 %.2f ms, max %.2f ms (%zu timed frames)\n",
       percentile(ms, 0.5), percentile(ms, 0.95), percentile(ms, 1.0), ms.size());
