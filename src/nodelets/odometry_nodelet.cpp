@@ -13,14 +13,16 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
-#include <pcl/PCLPointCloud2.h>
-#include <pcl_conversions/pcl_conversions.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <pluginlib/class_list_macros.hpp>
 
+#include <cstdint>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -105,12 +107,42 @@ class OdometryNodelet : public nodelet::Nodelet {
     have_intrinsics_ = true;
   }
 
-  static bool hasField(const sensor_msgs::PointCloud2& msg, const std::string& name) {
+  // Byte offset of a float32 field with one element that fits in a point, or -1.
+  static int floatField(const sensor_msgs::PointCloud2& msg, const std::string& name) {
     for (const auto& field : msg.fields) {
-      if (field.name == name)
-        return field.datatype == sensor_msgs::PointField::FLOAT32;
+      if (field.name == name) {
+        const bool ok = field.datatype == sensor_msgs::PointField::FLOAT32 && field.count == 1 &&
+                        field.offset + sizeof(float) <= msg.point_step;
+        return ok ? static_cast<int>(field.offset) : -1;
+      }
     }
-    return false;
+    return -1;
+  }
+
+  // Copies x y z normal_x normal_y normal_z (at the given offsets) into cloud_; curvature is not
+  // needed (and need not be present).
+  void convert(const sensor_msgs::PointCloud2& msg, const int (&offsets)[6]) {
+    cloud_.width = msg.width;
+    cloud_.height = msg.height;
+    cloud_.is_dense = false;
+    cloud_.points.resize(static_cast<std::size_t>(msg.width) * msg.height);
+    for (std::uint32_t row = 0; row < msg.height; ++row) {
+      const std::uint8_t* line = msg.data.data() + static_cast<std::size_t>(row) * msg.row_step;
+      for (std::uint32_t col = 0; col < msg.width; ++col) {
+        const std::uint8_t* in = line + static_cast<std::size_t>(col) * msg.point_step;
+        pcl::PointNormal& p = cloud_.points[static_cast<std::size_t>(row) * msg.width + col];
+        float v[6];
+        for (int i = 0; i < 6; ++i)
+          std::memcpy(&v[i], in + offsets[i], sizeof(float));
+        p.x = v[0];
+        p.y = v[1];
+        p.z = v[2];
+        p.normal_x = v[3];
+        p.normal_y = v[4];
+        p.normal_z = v[5];
+        p.curvature = 0.f;
+      }
+    }
   }
 
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
@@ -126,8 +158,12 @@ class OdometryNodelet : public nodelet::Nodelet {
       }
       intrinsics = intrinsics_;
     }
-    for (const char* name : {"x", "y", "z", "normal_x", "normal_y", "normal_z"}) {
-      if (!hasField(*msg, name)) {
+    const char* const names[6] = {"x", "y", "z", "normal_x", "normal_y", "normal_z"};
+    int offsets[6];
+    for (int i = 0; i < 6; ++i) {
+      const char* name = names[i];
+      offsets[i] = floatField(*msg, name);
+      if (offsets[i] < 0) {
         NODELET_ERROR_THROTTLE(5.0,
                                "odometry: cloud on %s has no float32 field '%s' (needs x y z "
                                "normal_x normal_y normal_z, e.g. from quadric_slam/"
@@ -143,9 +179,12 @@ class OdometryNodelet : public nodelet::Nodelet {
       return;
     }
     if (msg->data.size() < static_cast<std::size_t>(msg->row_step) * msg->height ||
-        msg->row_step < msg->point_step * msg->width) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: malformed cloud (%u x %u, %zu bytes); dropping it",
-                             msg->width, msg->height, msg->data.size());
+        msg->row_step < msg->point_step * msg->width || msg->is_bigendian) {
+      NODELET_ERROR_THROTTLE(5.0,
+                             "odometry: malformed or big-endian cloud (%u x %u, point_step %u, "
+                             "row_step %u, %zu bytes); dropping it",
+                             msg->width, msg->height, msg->point_step, msg->row_step,
+                             msg->data.size());
       return;
     }
 
@@ -161,10 +200,7 @@ class OdometryNodelet : public nodelet::Nodelet {
     have_stamp_ = true;
     last_stamp_ = stamp;
 
-    // pcl::fromROSMsg fills missing fields (curvature) with defaults without complaint.
-    pcl::PCLPointCloud2 pcl_msg;
-    pcl_conversions::toPCL(*msg, pcl_msg);
-    pcl::fromPCLPointCloud2(pcl_msg, cloud_);
+    convert(*msg, offsets);
 
     OdometryTracker::Result result;
     try {
