@@ -154,7 +154,9 @@ void computeBoxGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
         // Stay inside the image and away from edges: the box never straddles a discontinuity.
         const int r = std::min({static_cast<int>(half), static_cast<int>(dist_row[u]) - 1, u,
                                 width - 1 - u, v, height - 1 - v});
-        if (r < 1)
+        // Boxes squeezed by the image border or an edge to a few pixels give noisy normals (a
+        // few pixels' noise with a long lever arm): require a third of the full window.
+        if (r < std::max(2, static_cast<int>(half) / 3))
           continue;
         const int h = std::max(1, r / 2);
         Eigen::Vector3d left, right, up, down;

@@ -28,8 +28,11 @@
 #include <sstream>
 #include <string>
 
+#include "quadric_slam/io/pipeline_params.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
+#include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/params.h"
+#include "quadric_slam/ros/points_normals.h"
 
 namespace quadric_slam {
 
@@ -39,38 +42,16 @@ class OdometryNodelet : public nodelet::Nodelet {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& private_nh = getPrivateNodeHandle();
 
-    ros_params::ParamLog log;
+    ParamLog log;
     OdometryTracker::Params params;
-    PointToPlaneIcp::Params& icp = params.icp;
-    ros_params::read(private_nh, "odom_frame", odom_frame_, log);
-    ros_params::read(private_nh, "camera_frame", camera_frame_, log);
-    ros_params::read(private_nh, "publish_tf", publish_tf_, log);
-    ros_params::read(private_nh, "pyramid_levels", icp.pyramid_levels, log);
-    ros_params::read(private_nh, "finest_stride", icp.finest_stride, log);
-    ros_params::read(private_nh, "reference_stride", icp.reference_stride, log);
-    ros_params::read(private_nh, "max_iterations", icp.max_iterations, log);
-    ros_params::read(private_nh, "max_correspondence_distance", icp.max_correspondence_distance,
-                     log);
-    ros_params::read(private_nh, "coarse_distance_factor", icp.coarse_distance_factor, log);
-    ros_params::read(private_nh, "max_normal_angle", icp.max_normal_angle, log);
-    ros_params::read(private_nh, "depth_noise_weighting", icp.depth_noise_weighting, log);
-    ros_params::read(private_nh, "huber_delta", icp.huber_delta, log);
-    ros_params::read(private_nh, "convergence_translation", icp.convergence_translation, log);
-    ros_params::read(private_nh, "convergence_rotation", icp.convergence_rotation, log);
-    ros_params::read(private_nh, "min_correspondences", icp.min_correspondences, log);
-    ros_params::read(private_nh, "min_eigenvalue_ratio", icp.min_eigenvalue_ratio, log);
-    ros_params::read(private_nh, "degenerate_variance", icp.degenerate_variance, log);
-    ros_params::read(private_nh, "max_translation_from_guess", icp.max_translation_from_guess, log);
-    ros_params::read(private_nh, "max_rotation_from_guess", icp.max_rotation_from_guess, log);
-    ros_params::read(private_nh, "keyframe_translation", params.keyframe_translation, log);
-    ros_params::read(private_nh, "keyframe_rotation", params.keyframe_rotation, log);
-    ros_params::read(private_nh, "keyframe_min_overlap", params.keyframe_min_overlap, log);
-    ros_params::read(private_nh, "constant_velocity", params.constant_velocity, log);
-    ros_params::read(private_nh, "lost_frames_before_new_keyframe",
-                     params.lost_frames_before_new_keyframe, log);
     int queue_size = 5;
-    ros_params::read(private_nh, "queue_size", queue_size, log);
     try {
+      const RosParamReader reader(private_nh);
+      readParam(reader, "odom_frame", odom_frame_, log);
+      readParam(reader, "camera_frame", camera_frame_, log);
+      readParam(reader, "publish_tf", publish_tf_, log);
+      readOdometryParams(reader, params, log);
+      readParam(reader, "queue_size", queue_size, log);
       if (odom_frame_.empty() || camera_frame_.empty() || odom_frame_ == camera_frame_)
         throw std::invalid_argument("odom_frame and camera_frame must be non-empty and differ");
       if (queue_size < 1)
@@ -90,13 +71,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
-    CameraIntrinsics intrinsics;
-    intrinsics.fx = info->K[0];
-    intrinsics.fy = info->K[4];
-    intrinsics.cx = info->K[2];
-    intrinsics.cy = info->K[5];
-    intrinsics.width = static_cast<int>(info->width);
-    intrinsics.height = static_cast<int>(info->height);
+    const CameraIntrinsics intrinsics = intrinsicsFromCameraInfo(*info);
     const std::string problem = intrinsics.problem();
     if (!problem.empty()) {
       NODELET_ERROR_THROTTLE(5.0, "odometry: ignoring camera_info: %s", problem.c_str());
@@ -105,44 +80,6 @@ class OdometryNodelet : public nodelet::Nodelet {
     std::lock_guard<std::mutex> lock(intrinsics_mutex_);
     intrinsics_ = intrinsics;
     have_intrinsics_ = true;
-  }
-
-  // Byte offset of a float32 field with one element that fits in a point, or -1.
-  static int floatField(const sensor_msgs::PointCloud2& msg, const std::string& name) {
-    for (const auto& field : msg.fields) {
-      if (field.name == name) {
-        const bool ok = field.datatype == sensor_msgs::PointField::FLOAT32 && field.count == 1 &&
-                        field.offset + sizeof(float) <= msg.point_step;
-        return ok ? static_cast<int>(field.offset) : -1;
-      }
-    }
-    return -1;
-  }
-
-  // Copies x y z normal_x normal_y normal_z (at the given offsets) into cloud_; curvature is not
-  // needed (and need not be present).
-  void convert(const sensor_msgs::PointCloud2& msg, const int (&offsets)[6]) {
-    cloud_.width = msg.width;
-    cloud_.height = msg.height;
-    cloud_.is_dense = false;
-    cloud_.points.resize(static_cast<std::size_t>(msg.width) * msg.height);
-    for (std::uint32_t row = 0; row < msg.height; ++row) {
-      const std::uint8_t* line = msg.data.data() + static_cast<std::size_t>(row) * msg.row_step;
-      for (std::uint32_t col = 0; col < msg.width; ++col) {
-        const std::uint8_t* in = line + static_cast<std::size_t>(col) * msg.point_step;
-        pcl::PointNormal& p = cloud_.points[static_cast<std::size_t>(row) * msg.width + col];
-        float v[6];
-        for (int i = 0; i < 6; ++i)
-          std::memcpy(&v[i], in + offsets[i], sizeof(float));
-        p.x = v[0];
-        p.y = v[1];
-        p.z = v[2];
-        p.normal_x = v[3];
-        p.normal_y = v[4];
-        p.normal_z = v[5];
-        p.curvature = 0.f;
-      }
-    }
   }
 
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
@@ -158,33 +95,16 @@ class OdometryNodelet : public nodelet::Nodelet {
       }
       intrinsics = intrinsics_;
     }
-    const char* const names[6] = {"x", "y", "z", "normal_x", "normal_y", "normal_z"};
-    int offsets[6];
-    for (int i = 0; i < 6; ++i) {
-      const char* name = names[i];
-      offsets[i] = floatField(*msg, name);
-      if (offsets[i] < 0) {
-        NODELET_ERROR_THROTTLE(5.0,
-                               "odometry: cloud on %s has no float32 field '%s' (needs x y z "
-                               "normal_x normal_y normal_z, e.g. from quadric_slam/"
-                               "NormalEstimation); dropping it",
-                               cloud_sub_.getTopic().c_str(), name);
-        return;
-      }
-    }
     std::string problem;
     if (organizedCloudDecimation(intrinsics, static_cast<int>(msg->width),
                                  static_cast<int>(msg->height), &problem) == 0) {
       NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", problem.c_str());
       return;
     }
-    if (msg->data.size() < static_cast<std::size_t>(msg->row_step) * msg->height ||
-        msg->row_step < msg->point_step * msg->width || msg->is_bigendian) {
-      NODELET_ERROR_THROTTLE(5.0,
-                             "odometry: malformed or big-endian cloud (%u x %u, point_step %u, "
-                             "row_step %u, %zu bytes); dropping it",
-                             msg->width, msg->height, msg->point_step, msg->row_step,
-                             msg->data.size());
+    problem = pointsNormalsFromMsg(*msg, cloud_);
+    if (!problem.empty()) {
+      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud from %s: %s",
+                             cloud_sub_.getTopic().c_str(), problem.c_str());
       return;
     }
 
@@ -199,8 +119,6 @@ class OdometryNodelet : public nodelet::Nodelet {
     }
     have_stamp_ = true;
     last_stamp_ = stamp;
-
-    convert(*msg, offsets);
 
     OdometryTracker::Result result;
     try {

@@ -52,3 +52,26 @@ TEST(PipelineParams, ValuesOverrideDefaultsAndBadValuesAreRefused) {
       std::invalid_argument);
   EXPECT_THROW(qs::YamlParamReader::fromFile("/nonexistent.yaml"), std::runtime_error);
 }
+
+TEST(PipelineParams, OdometryYamlKeysAreAllRead) {
+  const YAML::Node file = YAML::LoadFile(kConfigDir + "odometry.yaml");
+  const qs::YamlParamReader reader(file);
+  qs::OdometryTracker::Params params;
+  qs::ParamLog log;
+  qs::readOdometryParams(reader, params, log);
+  // Nodelet-level keys, read beside the table.
+  std::string frame;
+  bool publish_tf = true;
+  int queue_size = 5;
+  qs::readParam(reader, "odom_frame", frame, log);
+  qs::readParam(reader, "camera_frame", frame, log);
+  qs::readParam(reader, "publish_tf", publish_tf, log);
+  qs::readParam(reader, "queue_size", queue_size, log);
+  for (const auto& entry : file) {
+    const std::string key = entry.first.as<std::string>();
+    EXPECT_NE(log.str().find("\n  " + key + ": "), std::string::npos)
+        << "config/odometry.yaml key '" << key << "' is read by nobody";
+  }
+  EXPECT_EQ(params.icp.pyramid_levels, file["pyramid_levels"].as<int>());
+  EXPECT_DOUBLE_EQ(params.keyframe_translation, file["keyframe_translation"].as<double>());
+}
