@@ -86,18 +86,7 @@ void TumFolderReader::Params::validate() const {
     throw std::invalid_argument("depth_units_per_metre must be in (0, inf), got " +
                                 std::to_string(depth_units_per_metre));
   }
-  if (!(max_rgb_difference > 0.0) || !std::isfinite(max_rgb_difference)) {
-    throw std::invalid_argument("max_rgb_difference must be in (0, inf) s, got " +
-                                std::to_string(max_rgb_difference));
-  }
-  if (intrinsics.fx != 0.0) {
-    CameraIntrinsics check = intrinsics;
-    if (check.width == 0 && check.height == 0)
-      check.width = check.height = 1;
-    const std::string problem = check.problem();
-    if (!problem.empty())
-      throw std::invalid_argument("intrinsics: " + problem);
-  }
+  validateReaderParams(max_rgb_difference, intrinsics);
 }
 
 TumFolderReader::TumFolderReader(const std::string& folder, const Params& params)

@@ -124,18 +124,7 @@ struct TumBagReader::Impl {
 void TumBagReader::Params::validate() const {
   if (depth_topic.empty())
     throw std::invalid_argument("depth_topic must not be empty");
-  if (!(max_rgb_difference > 0.0) || !std::isfinite(max_rgb_difference)) {
-    throw std::invalid_argument("max_rgb_difference must be in (0, inf) s, got " +
-                                std::to_string(max_rgb_difference));
-  }
-  if (intrinsics.fx != 0.0) {
-    CameraIntrinsics check = intrinsics;
-    if (check.width == 0 && check.height == 0)
-      check.width = check.height = 1;
-    const std::string problem = check.problem();
-    if (!problem.empty())
-      throw std::invalid_argument("intrinsics: " + problem);
-  }
+  validateReaderParams(max_rgb_difference, intrinsics);
   if (intrinsics.fx == 0.0 && camera_info_topic.empty()) {
     throw std::invalid_argument(
         "camera_info_topic must not be empty without an intrinsics override");

@@ -2,7 +2,6 @@
 // 640x480 TUM depth frame: median and p95 over N runs per method.
 //
 //   bench_normals [--runs N] [--depth PNG] [--method NAME|all] [--smoothing PIXELS]
-#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -13,6 +12,8 @@
 
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/io/depth_png.h"
+#include "quadric_slam/io/frame_source.h"
 
 namespace qs = quadric_slam;
 
@@ -56,33 +57,31 @@ int main(int argc, char** argv) {
       return usage();
     }
   }
-  const cv::Mat raw = cv::imread(depth_file, cv::IMREAD_ANYDEPTH);
-  if (raw.empty() || raw.type() != CV_16UC1 || runs < 1) {
-    std::fprintf(stderr, "bench_normals: cannot read a 16-bit depth PNG from %s\n",
-                 depth_file.c_str());
+  cv::Mat depth_m;
+  try {
+    depth_m = qs::readTumDepthPng(depth_file);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_normals: %s\n", e.what());
     return 1;
   }
+  if (runs < 1)
+    return usage();
   qs::CameraIntrinsics intrinsics;  // Freiburg3, as in shared/data/README.md
   intrinsics.fx = 535.4;
   intrinsics.fy = 539.2;
   intrinsics.cx = 320.1;
   intrinsics.cy = 247.6;
-  intrinsics.width = raw.cols;
-  intrinsics.height = raw.rows;
-  qs::DepthImageView<std::uint16_t> view;
-  view.data = raw.data;
-  view.width = raw.cols;
-  view.height = raw.rows;
-  view.row_step_bytes = raw.step;
-  view.metres_per_unit = 1.0 / 5000.0;
+  intrinsics.width = depth_m.cols;
+  intrinsics.height = depth_m.rows;
+  const qs::DepthImageView<float> view = qs::depthViewOf(depth_m);
 
   std::vector<std::string> methods = {method};
   if (method == "all") {
     methods = {"box_gradient", "average_3d_gradient", "covariance_matrix", "average_depth_change",
                "simple_3d_gradient"};
   }
-  std::printf("frame %dx%d from %s, %d runs per method\n", raw.cols, raw.rows, depth_file.c_str(),
-              runs);
+  std::printf("frame %dx%d from %s, %d runs per method\n", depth_m.cols, depth_m.rows,
+              depth_file.c_str(), runs);
   std::printf("%-22s %10s %10s %10s %10s\n", "method", "median_ms", "p95_ms", "backproj_ms",
               "valid");
   for (const std::string& name : methods) {

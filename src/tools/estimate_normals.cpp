@@ -14,6 +14,8 @@
 
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/io/depth_png.h"
+#include "quadric_slam/io/frame_source.h"
 
 namespace qs = quadric_slam;
 
@@ -67,21 +69,12 @@ int main(int argc, char** argv) {
   if (out_dir.empty() || !(units_per_metre > 0))
     return usage();
 
-  const cv::Mat raw = cv::imread(depth_file, cv::IMREAD_ANYDEPTH);
-  if (raw.empty() || raw.type() != CV_16UC1) {
-    std::fprintf(stderr, "estimate_normals: %s is not a 16-bit depth PNG\n", depth_file.c_str());
-    return 1;
-  }
-  intrinsics.width = raw.cols;
-  intrinsics.height = raw.rows;
   try {
+    const cv::Mat raw = qs::readTumDepthPng(depth_file, units_per_metre);
+    intrinsics.width = raw.cols;
+    intrinsics.height = raw.rows;
     const qs::NormalEstimator estimator(params);
-    qs::DepthImageView<std::uint16_t> view;
-    view.data = raw.data;
-    view.width = raw.cols;
-    view.height = raw.rows;
-    view.row_step_bytes = raw.step;
-    view.metres_per_unit = 1.0 / units_per_metre;
+    const qs::DepthImageView<float> view = qs::depthViewOf(raw);
     const auto t0 = std::chrono::steady_clock::now();
     const auto cloud = estimator.compute(qs::backProject(view, intrinsics, {}));
     const double ms =

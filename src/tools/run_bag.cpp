@@ -121,7 +121,8 @@ qs::YamlParamReader configFile(const Options& o, const std::string& name) {
 
 void printTrajectoryErrors(const std::string& gt_path, const qs::Trajectory& estimate) {
   const qs::Trajectory gt = qs::readTumTrajectory(gt_path);
-  const auto ate = qs::AbsoluteTrajectoryError(qs::AbsoluteTrajectoryError::Params{}).evaluate(gt, estimate);
+  const auto ate =
+      qs::AbsoluteTrajectoryError(qs::AbsoluteTrajectoryError::Params{}).evaluate(gt, estimate);
   std::printf("ate_rmse_m %.6f\npairs %zu\n", ate.rmse(), ate.pairs());
   try {
     const auto rpe = qs::RelativePoseError(qs::RelativePoseError::Params{}).evaluate(gt, estimate);
@@ -184,12 +185,7 @@ int main(int argc, char** argv) {
         continue;
       }
       const pcl::PointCloud<pcl::PointNormal> cloud = timer.time("normals", [&] {
-        qs::DepthImageView<float> view;
-        view.data = frame.depth_m.data;
-        view.width = frame.depth_m.cols;
-        view.height = frame.depth_m.rows;
-        view.row_step_bytes = frame.depth_m.step;
-        return normals.compute(qs::backProject(view, k, back_projection));
+        return normals.compute(qs::backProject(qs::depthViewOf(frame.depth_m), k, back_projection));
       });
       const qs::OdometryTracker::Result result =
           timer.time("odometry", [&] { return odometry.track(cloud, k, frame.stamp); });

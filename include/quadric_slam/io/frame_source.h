@@ -19,6 +19,15 @@ struct RgbdFrame {
   std::string frame_id;         // optical frame of the depth camera
 };
 
+// A CV_32FC1 depth image in metres as the back-projection's view (no copy; the Mat must outlive
+// it).
+DepthImageView<float> depthViewOf(const cv::Mat& depth_m);
+
+// Checks the parameters every reader shares: the RGB pairing gate (s, > 0) and an optional
+// intrinsics override (fx = 0: none; width/height 0: from the images). Throws
+// std::invalid_argument naming the bad field.
+void validateReaderParams(double max_rgb_difference, const CameraIntrinsics& intrinsics_override);
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
