@@ -1,6 +1,7 @@
 #include "quadric_slam/frontend/quadric_segmenter.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -19,6 +20,11 @@ void require(bool ok, const std::string& message) {
 
 std::string str(double value) {
   return std::to_string(value);
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 Eigen::Vector3d pointOf(const pcl::PointNormal& p) {
@@ -105,6 +111,41 @@ std::vector<int> assignLargestComponent(const Frame& frame, const PrimitiveShape
       best.swap(component);
   }
   return best;
+}
+
+// 4-connected components of the valid, unused points (depth jumps break connectivity).
+std::vector<std::vector<int>> freeComponents(const Frame& frame,
+                                             const QuadricSegmenter::Params& p) {
+  std::vector<std::vector<int>> components;
+  std::vector<std::uint8_t> seen(frame.valid.size(), 0);
+  std::vector<int> stack;
+  const auto& points = frame.cloud.points;
+  for (int start = 0; start < static_cast<int>(seen.size()); ++start) {
+    if (seen[start] || !frame.valid[start] || frame.used[start])
+      continue;
+    std::vector<int> component;
+    stack.assign(1, start);
+    seen[start] = 1;
+    while (!stack.empty()) {
+      const int k = stack.back();
+      stack.pop_back();
+      component.push_back(k);
+      const int u = k % frame.width, v = k / frame.width;
+      const int neighbours[4] = {u > 0 ? k - 1 : -1, u + 1 < frame.width ? k + 1 : -1,
+                                 v > 0 ? k - frame.width : -1,
+                                 v + 1 < frame.height ? k + frame.width : -1};
+      for (int m : neighbours) {
+        if (m < 0 || seen[m] || !frame.valid[m] || frame.used[m])
+          continue;
+        if (std::abs(points[m].z - points[k].z) > p.planes.max_depth_jump_factor * points[k].z)
+          continue;
+        seen[m] = 1;
+        stack.push_back(m);
+      }
+    }
+    components.push_back(std::move(component));
+  }
+  return components;
 }
 
 ImageRoi roiOf(const std::vector<int>& indices, int width) {
@@ -200,6 +241,10 @@ void QuadricSegmenter::Params::validate() const {
   require(cgal_epsilon > 0, "cgal_epsilon must be > 0 m, got " + str(cgal_epsilon));
   require(cgal_cluster_epsilon > 0,
           "cgal_cluster_epsilon must be > 0 m, got " + str(cgal_cluster_epsilon));
+  require(cgal_max_points >= 100,
+          "cgal_max_points must be >= 100, got " + std::to_string(cgal_max_points));
+  require(cgal_min_fraction >= 0 && cgal_min_fraction < 1,
+          "cgal_min_fraction must be in [0, 1), got " + str(cgal_min_fraction));
   require(cgal_normal_threshold > 0 && cgal_normal_threshold < 1,
           "cgal_normal_threshold must be in (0, 1), got " + str(cgal_normal_threshold));
   require(curved_max_normal_angle > 0 && curved_max_normal_angle < M_PI / 2,
@@ -271,6 +316,7 @@ Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& 
     result.detections.push_back(std::move(detection));
   };
 
+  auto start = std::chrono::steady_clock::now();
   // 1. Planes from the image grid.
   const PlaneRegionGrower grower(p.planes);
   for (const PlaneRegionGrower::Region& region : grower.grow(cloud, frame.valid, frame.used)) {
@@ -278,37 +324,64 @@ Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& 
     accept(fit.shape, region.indices, fit);
   }
 
-  // 2. Curved candidates from CGAL on a sub-sample of the free points.
+  result.timings.planes_ms = msSince(start);
+  start = std::chrono::steady_clock::now();
+
+  // 2. Curved candidates from CGAL, run per image-grid connected component of the free points (on
+  // a sub-sample): small inputs with a support threshold relative to their size converge in few
+  // RANSAC rounds, and a shape never spans two separate objects.
   if (!(p.detect_spheres || p.detect_cylinders || p.detect_cones))
     return result;
-  std::vector<Eigen::Vector3d> sample_points, sample_normals;
-  std::vector<int> sample_pixel;
-  for (int v = 0; v < height; v += p.cgal_stride) {
-    for (int u = 0; u < width; u += p.cgal_stride) {
-      const int i = v * width + u;
-      if (!frame.valid[i] || frame.used[i])
-        continue;
-      sample_points.push_back(pointOf(cloud.points[i]));
-      sample_normals.push_back(normalOf(cloud.points[i]).normalized());
-      sample_pixel.push_back(i);
-    }
-  }
   CgalShapeDetector::Params cgal;
   cgal.planes = true;  // absorbs small planar patches that would otherwise become wide cylinders
   cgal.spheres = p.detect_spheres;
   cgal.cylinders = p.detect_cylinders;
   cgal.cones = p.detect_cones;
   cgal.probability = p.cgal_probability;
-  cgal.min_points = p.cgal_min_points;
   cgal.epsilon = p.cgal_epsilon;
   cgal.cluster_epsilon = p.cgal_cluster_epsilon;
   cgal.normal_threshold = p.cgal_normal_threshold;
   cgal.random_seed = p.random_seed;
-  std::vector<CgalShapeDetector::Shape> candidates =
-      CgalShapeDetector(cgal).detect(sample_points, sample_normals);
+  std::vector<Eigen::Vector3d> sample_points, sample_normals;
+  std::vector<int> sample_pixel;
+  std::vector<CgalShapeDetector::Shape> candidates;
+  for (const std::vector<int>& component : freeComponents(frame, p)) {
+    if (static_cast<int>(component.size()) < p.min_curved_points)
+      continue;
+    const std::size_t first = sample_points.size();
+    // A stride that keeps the component's sample within cgal_max_points.
+    const int stride = std::max(
+        p.cgal_stride, static_cast<int>(std::ceil(
+                           std::sqrt(static_cast<double>(component.size()) / p.cgal_max_points))));
+    for (int i : component) {
+      if ((i % width) % stride != 0 || (i / width) % stride != 0)
+        continue;
+      sample_points.push_back(pointOf(cloud.points[i]));
+      sample_normals.push_back(normalOf(cloud.points[i]).normalized());
+      sample_pixel.push_back(i);
+    }
+    const int count = static_cast<int>(sample_points.size() - first);
+    cgal.min_points =
+        std::max(p.cgal_min_points, static_cast<int>(std::ceil(p.cgal_min_fraction * count)));
+    if (count < cgal.min_points)
+      continue;
+    const std::vector<Eigen::Vector3d> points(sample_points.begin() + first, sample_points.end());
+    const std::vector<Eigen::Vector3d> normals(sample_normals.begin() + first,
+                                               sample_normals.end());
+    for (CgalShapeDetector::Shape& shape : CgalShapeDetector(cgal).detect(points, normals)) {
+      for (int& k : shape.indices)
+        k += static_cast<int>(first);
+      candidates.push_back(std::move(shape));
+    }
+  }
   std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
     return a.indices.size() > b.indices.size();
   });
+
+  result.timings.ransac_points = static_cast<int>(sample_points.size());
+  result.timings.ransac_candidates = static_cast<int>(candidates.size());
+  result.timings.ransac_ms = msSince(start);
+  start = std::chrono::steady_clock::now();
 
   // 3. Verify, refine and re-assign each curved candidate, biggest first.
   for (const CgalShapeDetector::Shape& candidate : candidates) {
@@ -362,6 +435,7 @@ Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& 
       continue;
     accept(fit.shape, indices, fit);
   }
+  result.timings.verify_ms = msSince(start);
   return result;
 }
 

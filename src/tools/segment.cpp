@@ -1,6 +1,7 @@
 // segment: one frame -> quadric observations, with the same core classes the nodelet uses.
 //
 //   segment INPUT --out DIR [--intrinsics fx,fy,cx,cy] [--depth-scale UNITS_PER_M]
+//           [--config segmentation.yaml] [--set KEY=VALUE]...
 //
 // INPUT is a 16-bit depth PNG (back-projected with --intrinsics, default the ROS Kinect defaults
 // 525,525,319.5,239.5, and --depth-scale units per metre, default 5000) or an organized PCD (x y z
@@ -20,19 +21,23 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/frontend/segmentation_input.h"
+#include "quadric_slam/frontend/segmenter_params.h"
 
 namespace qs = quadric_slam;
 
 namespace {
 
 int usage() {
-  std::fprintf(stderr,
-               "usage: segment INPUT(.png|.pcd) --out DIR [--intrinsics fx,fy,cx,cy] "
-               "[--depth-scale UNITS_PER_M (5000)]\n");
+  std::fprintf(
+      stderr,
+      "usage: segment INPUT(.png|.pcd) --out DIR [--intrinsics fx,fy,cx,cy] "
+      "[--depth-scale UNITS_PER_M (5000)] [--config segmentation.yaml] [--set KEY=VALUE]...\n");
   return 2;
 }
 
@@ -80,6 +85,8 @@ int main(int argc, char** argv) {
   intrinsics.cx = 319.5;
   intrinsics.cy = 239.5;
   double units_per_metre = 5000.0;
+  std::string config;
+  std::vector<std::pair<std::string, double>> overrides;
   for (int i = 2; i < argc; ++i) {
     const std::string arg = argv[i];
     if (i + 1 >= argc)
@@ -92,6 +99,13 @@ int main(int argc, char** argv) {
         return usage();
     } else if (arg == "--depth-scale") {
       units_per_metre = std::atof(value.c_str());
+    } else if (arg == "--config") {
+      config = value;
+    } else if (arg == "--set") {
+      const std::size_t eq = value.find('=');
+      if (eq == std::string::npos)
+        return usage();
+      overrides.emplace_back(value.substr(0, eq), std::atof(value.c_str() + eq + 1));
     } else {
       return usage();
     }
@@ -103,7 +117,11 @@ int main(int argc, char** argv) {
     const pcl::PointCloud<pcl::PointXYZ> cloud =
         qs::loadOrganizedCloud(input, intrinsics, units_per_metre);
     const qs::NormalEstimator estimator{qs::NormalEstimator::Params()};
-    const qs::QuadricSegmenter segmenter{qs::QuadricSegmenter::Params()};
+    qs::QuadricSegmenter::Params params =
+        config.empty() ? qs::QuadricSegmenter::Params() : qs::loadSegmenterParams(config);
+    for (const auto& [key, value] : overrides)
+      qs::setSegmenterParam(params, key, value);
+    const qs::QuadricSegmenter segmenter(params);
     const auto t0 = std::chrono::steady_clock::now();
     const pcl::PointCloud<pcl::PointNormal> with_normals = estimator.compute(cloud);
     const auto t1 = std::chrono::steady_clock::now();
@@ -121,9 +139,12 @@ int main(int argc, char** argv) {
       throw std::runtime_error("cannot write " + out_dir + "/segmentation.png");
 
     using ms = std::chrono::duration<double, std::milli>;
-    std::printf("segment: %s: %zu observations (normals %.1f ms, segmentation %.1f ms)\n",
-                input.c_str(), segmentation.detections.size(), ms(t1 - t0).count(),
-                ms(t2 - t1).count());
+    const qs::SegmentationTimings& t = segmentation.timings;
+    std::printf(
+        "segment: %s: %zu observations (normals %.1f ms, segmentation %.1f ms: planes %.1f, "
+        "ransac %.1f on %d points -> %d candidates, verification %.1f)\n",
+        input.c_str(), segmentation.detections.size(), ms(t1 - t0).count(), ms(t2 - t1).count(),
+        t.planes_ms, t.ransac_ms, t.ransac_points, t.ransac_candidates, t.verify_ms);
     for (const qs::QuadricDetection& d : segmentation.detections) {
       std::printf("  label %u %-8s points %6d rms %.4f m shape", d.label,
                   qs::toString(d.shape.quadric_class).c_str(), d.num_points, d.fit_rms);

@@ -5,7 +5,8 @@
 // Pipeline (all in the camera frame):
 //  1. planes by region growing over the image grid (plane_region_grower.h), flatness-checked;
 //  2. CGAL Efficient RANSAC (Schnabel et al. 2007) with sphere, cylinder, cone (and plane, to
-//     absorb small planar patches) on a sub-sample of the remaining points;
+//     absorb small planar patches) on a sub-sample of each image-grid connected component of
+//     the remaining points;
 //  3. for each CGAL shape, biggest first: range and degeneracy filters (huge-radius cylinders,
 //     near-flat cones and big spheres are tested against a plane; thin cones against a
 //     cylinder), least-squares refinement, re-assignment of all free full-resolution pixels
@@ -48,7 +49,17 @@ struct QuadricDetection {
   Eigen::Vector3d extent_min = Eigen::Vector3d::Zero(), extent_max = Eigen::Vector3d::Zero();
 };
 
+// Wall-clock time of the segmenter's stages for one frame (ms), for benchmarks and diagnostics.
+struct SegmentationTimings {
+  double planes_ms = 0.0;     // region growing, merging and plane refinement
+  double ransac_ms = 0.0;     // sub-sampling and CGAL Efficient RANSAC
+  double verify_ms = 0.0;     // filters, refinement and re-assignment of curved candidates
+  int ransac_points = 0;      // points given to CGAL
+  int ransac_candidates = 0;  // shapes CGAL returned
+};
+
 struct Segmentation {
+  SegmentationTimings timings;
   std::vector<QuadricDetection> detections;
   // CV_16UC1, the cloud's size: 0 = unassigned, else the label of the detection owning the point.
   cv::Mat labels;
@@ -64,16 +75,21 @@ class QuadricSegmenter {
     PlaneRegionGrower::Params planes;
     // Curved shapes.
     bool detect_spheres = true, detect_cylinders = true, detect_cones = true;
-    // Every cgal_stride-th free pixel in u and v goes to CGAL, [1, 16]. Default 2.
-    int cgal_stride = 2;
+    // Every cgal_stride-th free pixel in u and v goes to CGAL, [1, 16]. Default 3.
+    int cgal_stride = 3;
+    // A larger stride is used in a component that would give CGAL more points than this, >= 100.
+    int cgal_max_points = 2000;
     // CGAL Efficient RANSAC: probability of missing the largest shape, (0, 1); minimum support
     // (sub-sampled points), >= 4; distance epsilon (m), > 0; cluster epsilon (m), > 0; normal
     // threshold (cosine), (0, 1).
-    double cgal_probability = 0.05;
-    int cgal_min_points = 60;
+    double cgal_probability = 0.2;
+    int cgal_min_points = 40;
     double cgal_epsilon = 0.008;
     double cgal_cluster_epsilon = 0.03;
     double cgal_normal_threshold = 0.85;
+    // CGAL runs once per connected component of the free points; its minimum support there is
+    // max(cgal_min_points, cgal_min_fraction * sub-sampled component size), [0, 1).
+    double cgal_min_fraction = 0.08;
     // Assignment of full-resolution pixels to a curved shape: distance threshold
     // max(min_distance, distance_factor * z^2) of the planes, and this normal angle (rad),
     // (0, pi/2).

@@ -1,0 +1,24 @@
+// The QuadricSegmenter parameters by name: one table shared by config/segmentation.yaml, the
+// nodelet's private parameters and the offline tools, so every consumer reads the same keys.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "quadric_slam/frontend/quadric_segmenter.h"
+
+namespace quadric_slam {
+
+// Every key of config/segmentation.yaml, in file order.
+const std::vector<std::string>& segmenterParamNames();
+// Value of a key as a double (booleans 0/1, integers exactly). Throws std::invalid_argument for
+// an unknown key.
+double getSegmenterParam(const QuadricSegmenter::Params& params, const std::string& key);
+// Sets a key (integers are rounded, booleans are value != 0). Throws std::invalid_argument for an
+// unknown key. Call params.validate() afterwards.
+void setSegmenterParam(QuadricSegmenter::Params& params, const std::string& key, double value);
+// Reads the keys present in a YAML file of the config/segmentation.yaml form (unknown keys throw
+// std::invalid_argument naming them; absent keys keep their defaults); validates.
+QuadricSegmenter::Params loadSegmenterParams(const std::string& yaml_path);
+
+}  // namespace quadric_slam
