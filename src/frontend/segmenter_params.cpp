@@ -122,6 +122,8 @@ QuadricSegmenter::Params loadSegmenterParams(const std::string& yaml_path) {
   Params params;
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
+    if (key == "queue_size")  // the nodelet's own key
+      continue;
     const Entry& e = find(key);
     try {
       if (e.flag)
