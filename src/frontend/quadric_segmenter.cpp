@@ -230,6 +230,8 @@ void QuadricSegmenter::Params::validate() const {
   require(min_range > 0 && min_range < max_range,
           "min_range and max_range must satisfy 0 < min_range < max_range (m), got " +
               str(min_range) + ", " + str(max_range));
+  require(decimation >= 1 && decimation <= 8,
+          "decimation must be in [1, 8], got " + std::to_string(decimation));
   planes.validate();
   refiner.validate();
   require(cgal_stride >= 1 && cgal_stride <= 16,
@@ -269,10 +271,11 @@ QuadricSegmenter::QuadricSegmenter(const Params& params) : params_(params) {
   params_.validate();
 }
 
-Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& cloud) const {
-  if (!cloud.isOrganized() && !cloud.empty())
-    throw std::invalid_argument("QuadricSegmenter: the cloud must be organized");
-  const Params& p = params_;
+namespace {
+
+// The segmentation proper, on the grid of the cloud it is given.
+Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
+                         const QuadricSegmenter::Params& p) {
   Segmentation result;
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
   result.labels = cv::Mat::zeros(height, width, CV_16UC1);
@@ -320,7 +323,8 @@ Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& 
   // 1. Planes from the image grid.
   const PlaneRegionGrower grower(p.planes);
   for (const PlaneRegionGrower::Region& region : grower.grow(cloud, frame.valid, frame.used)) {
-    const ShapeRefiner::Result fit = refiner.refine(region.plane, pointsOf(cloud, region.indices));
+    const ShapeRefiner::Result fit =
+        refiner.evaluate(region.plane, pointsOf(cloud, region.indices));
     accept(fit.shape, region.indices, fit);
   }
 
@@ -414,12 +418,18 @@ Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& 
       }
       const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
       fit = refiner.refine(fit.shape, points);
-      // Degeneracy: a thin cone is a cylinder.
+      // Model selection: a simpler class that fits almost as well wins (a thin cone is a
+      // cylinder; a wide cone or a cylinder on a sphere cap is a sphere).
       if (fit.shape.quadric_class == QuadricClass::kCone) {
         const ShapeRefiner::Result as_cylinder =
             refiner.refine(cylinderFromCone(fit.shape, points), points);
-        if (as_cylinder.rms < p.cylinder_rms_ratio * fit.rms)
+        if (as_cylinder.rms < p.cylinder_rms_ratio * fit.rms && plausible(as_cylinder.shape, p))
           fit = as_cylinder;
+      }
+      if (fit.shape.quadric_class != QuadricClass::kSphere && p.detect_spheres) {
+        const ShapeRefiner::Result as_sphere = refiner.refine(fitSphereAlgebraic(points), points);
+        if (as_sphere.rms < p.cylinder_rms_ratio * fit.rms && plausible(as_sphere.shape, p))
+          fit = as_sphere;
       }
     }
     if (indices.empty() || !plausible(fit.shape, p))
@@ -436,6 +446,137 @@ Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& 
     accept(fit.shape, indices, fit);
   }
   result.timings.verify_ms = msSince(start);
+  return result;
+}
+
+// The parameters of a grid decimated by d: counts of points scale with 1 / d^2, strides with 1 / d.
+QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) {
+  QuadricSegmenter::Params c = p;
+  c.planes.min_points = std::max(3, p.planes.min_points / (d * d));
+  c.min_curved_points = std::max(4, p.min_curved_points / (d * d));
+  c.planes.seed_stride = std::max(1, p.planes.seed_stride / d);
+  c.cgal_stride = std::max(1, (p.cgal_stride + d / 2) / d);
+  c.decimation = 1;
+  return c;
+}
+
+bool validPoint(const pcl::PointNormal& q, const QuadricSegmenter::Params& p) {
+  return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+         std::isfinite(q.normal_x) && std::isfinite(q.normal_y) && std::isfinite(q.normal_z) &&
+         q.z >= p.min_range && q.z <= p.max_range;
+}
+
+// Full-resolution labels from a segmentation of the grid decimated by d: each valid pixel takes
+// the label of a neighbouring coarse sample whose surface it fits (distance threshold and normal
+// agreement, as on the coarse grid); support, ROI, extent and covariance follow the full-resolution
+// points.
+Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
+                      const QuadricSegmenter::Params& p) {
+  Segmentation result;
+  result.timings = coarse.timings;
+  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+  result.labels = cv::Mat::zeros(height, width, CV_16UC1);
+  const int n = static_cast<int>(coarse.detections.size());
+  std::vector<Eigen::Isometry3d> T_quadric_camera(n);
+  std::vector<double> cos_angle(n);
+  for (int k = 0; k < n; ++k) {
+    T_quadric_camera[k] = coarse.detections[k].shape.poseInFrame().inverse();
+    cos_angle[k] = std::cos(coarse.detections[k].shape.quadric_class == QuadricClass::kPlane
+                                ? p.planes.max_normal_angle
+                                : p.curved_max_normal_angle);
+  }
+  std::vector<int> count(n, 0);
+  std::vector<Eigen::Vector3d> lo(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
+  std::vector<Eigen::Vector3d> hi(n,
+                                  Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
+  std::vector<ImageRoi> box(n, ImageRoi{width, height, -1, -1});  // x, y min; width, height = max
+  const int cw = coarse.labels.cols, ch = coarse.labels.rows;
+  for (int v = 0; v < height; ++v) {
+    const int cv0 = std::min(v / d, ch - 1), cv1 = std::min(v / d + 1, ch - 1);
+    for (int u = 0; u < width; ++u) {
+      const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
+      if (!validPoint(q, p))
+        continue;
+      const int cu0 = std::min(u / d, cw - 1), cu1 = std::min(u / d + 1, cw - 1);
+      const std::uint16_t candidates[4] = {
+          coarse.labels.at<std::uint16_t>(cv0, cu0), coarse.labels.at<std::uint16_t>(cv0, cu1),
+          coarse.labels.at<std::uint16_t>(cv1, cu0), coarse.labels.at<std::uint16_t>(cv1, cu1)};
+      const Eigen::Vector3d point = pointOf(q);
+      const double threshold = depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
+      int best = 0;
+      double best_distance = threshold;
+      for (int c = 0; c < 4; ++c) {
+        const int label = candidates[c];
+        if (label == 0 || label == best)
+          continue;
+        const PrimitiveShape& shape = coarse.detections[label - 1].shape;
+        const double distance = std::abs(shape.distance(point));
+        if (distance >= best_distance)
+          continue;
+        if (std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
+          continue;
+        best = label;
+        best_distance = distance;
+      }
+      if (best == 0)
+        continue;
+      result.labels.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(best);
+      const int k = best - 1;
+      ++count[k];
+      const Eigen::Vector3d local = T_quadric_camera[k] * point;
+      lo[k] = lo[k].cwiseMin(local);
+      hi[k] = hi[k].cwiseMax(local);
+      box[k].x = std::min(box[k].x, u);
+      box[k].y = std::min(box[k].y, v);
+      box[k].width = std::max(box[k].width, u);
+      box[k].height = std::max(box[k].height, v);
+    }
+  }
+  // Keep the detections with support, renumbered 1..m.
+  std::vector<std::uint16_t> relabel(n + 1, 0);
+  for (int k = 0; k < n; ++k) {
+    if (count[k] == 0)
+      continue;
+    QuadricDetection detection = coarse.detections[k];
+    detection.label = static_cast<std::uint16_t>(result.detections.size() + 1);
+    relabel[k + 1] = detection.label;
+    // More points of the same noise: the covariance shrinks with the support.
+    detection.covariance *= static_cast<double>(detection.num_points) / count[k];
+    detection.num_points = count[k];
+    detection.extent_min = lo[k];
+    detection.extent_max = hi[k];
+    detection.roi =
+        ImageRoi{box[k].x, box[k].y, box[k].width - box[k].x + 1, box[k].height - box[k].y + 1};
+    result.detections.push_back(std::move(detection));
+  }
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u) {
+      std::uint16_t& label = result.labels.at<std::uint16_t>(v, u);
+      label = relabel[label];
+    }
+  return result;
+}
+
+}  // namespace
+
+Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& cloud) const {
+  if (!cloud.isOrganized() && !cloud.empty())
+    throw std::invalid_argument("QuadricSegmenter: the cloud must be organized");
+  const int d = params_.decimation;
+  if (d == 1 || cloud.width < static_cast<std::uint32_t>(4 * d) ||
+      cloud.height < static_cast<std::uint32_t>(4 * d))
+    return segmentGrid(cloud, params_);
+  const auto start = std::chrono::steady_clock::now();
+  pcl::PointCloud<pcl::PointNormal> grid(cloud.width / d, cloud.height / d);
+  grid.is_dense = false;
+  for (std::uint32_t r = 0; r < grid.height; ++r)
+    for (std::uint32_t c = 0; c < grid.width; ++c)
+      grid(c, r) = cloud(c * d, r * d);
+  const double decimate_ms = msSince(start);
+  Segmentation coarse = segmentGrid(grid, coarseParams(params_, d));
+  const auto upsample_start = std::chrono::steady_clock::now();
+  Segmentation result = upsample(cloud, std::move(coarse), d, params_);
+  result.timings.upsample_ms = decimate_ms + msSince(upsample_start);
   return result;
 }
 

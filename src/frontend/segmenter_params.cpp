@@ -34,6 +34,7 @@ const std::vector<Entry>& table() {
   static const std::vector<Entry> entries = {
       real("min_range", [](Params& p) -> double& { return p.min_range; }),
       real("max_range", [](Params& p) -> double& { return p.max_range; }),
+      integer("decimation", [](Params& p) -> int& { return p.decimation; }),
       real("plane_max_normal_angle",
            [](Params& p) -> double& { return p.planes.max_normal_angle; }),
       real("distance_factor", [](Params& p) -> double& { return p.planes.distance_factor; }),

@@ -49,6 +49,43 @@ Eigen::MatrixXd jacobian(const PrimitiveShape& shape, const std::vector<Eigen::V
   return J;
 }
 
+std::vector<Eigen::Vector3d> subsample(const std::vector<Eigen::Vector3d>& all_points,
+                                       int max_points) {
+  if (static_cast<int>(all_points.size()) <= max_points)
+    return all_points;
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(max_points);
+  const double step = static_cast<double>(all_points.size()) / max_points;
+  for (int i = 0; i < max_points; ++i)
+    points.push_back(all_points[static_cast<std::size_t>(i * step)]);
+  return points;
+}
+
+// Covariance of the fit: sigma^2 (J^T J)^-1, J over all points (the sub-sample's normal matrix
+// scaled by N / n), sigma^2 the residual variance.
+ShapeRefiner::Result covarianceOf(const PrimitiveShape& shape,
+                                  const std::vector<Eigen::Vector3d>& points,
+                                  std::size_t all_points) {
+  ShapeRefiner::Result result;
+  const int k = minimalDimension(shape.quadric_class);
+  const double cost = residuals(shape, points).squaredNorm();
+  const Eigen::MatrixXd J = jacobian(shape, points);
+  Eigen::MatrixXd H = J.transpose() * J;
+  H *= static_cast<double>(all_points) / static_cast<double>(points.size());
+  const double sigma2 = cost / (static_cast<double>(points.size()) - k);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
+  result.shape = shape;
+  result.rms = std::sqrt(cost / points.size());
+  if (eig.info() != Eigen::Success ||
+      eig.eigenvalues().minCoeff() <= 1e-12 * eig.eigenvalues().maxCoeff()) {
+    result.covariance = Eigen::MatrixXd::Identity(k, k) * 1e6;
+    return result;
+  }
+  result.covariance = sigma2 * H.inverse();
+  result.ok = true;
+  return result;
+}
+
 }  // namespace
 
 ShapeRefiner::Result ShapeRefiner::refine(const PrimitiveShape& initial,
@@ -59,15 +96,7 @@ ShapeRefiner::Result ShapeRefiner::refine(const PrimitiveShape& initial,
   if (static_cast<int>(all_points.size()) <= k)
     return result;
 
-  std::vector<Eigen::Vector3d> points;
-  if (static_cast<int>(all_points.size()) > params_.max_points) {
-    points.reserve(params_.max_points);
-    const double step = static_cast<double>(all_points.size()) / params_.max_points;
-    for (int i = 0; i < params_.max_points; ++i)
-      points.push_back(all_points[static_cast<std::size_t>(i * step)]);
-  } else {
-    points = all_points;
-  }
+  const std::vector<Eigen::Vector3d> points = subsample(all_points, params_.max_points);
 
   PrimitiveShape shape = initial;
   Eigen::VectorXd r = residuals(shape, points);
@@ -104,24 +133,16 @@ ShapeRefiner::Result ShapeRefiner::refine(const PrimitiveShape& initial,
       break;
   }
 
-  // Covariance of the fit: sigma^2 (J^T J)^-1, J over all points (the sub-sample's normal matrix
-  // scaled by N / n).
-  const Eigen::MatrixXd J = jacobian(shape, points);
-  Eigen::MatrixXd H = J.transpose() * J;
-  H *= static_cast<double>(all_points.size()) / static_cast<double>(points.size());
-  const double dof = static_cast<double>(points.size()) - k;
-  const double sigma2 = cost / dof;
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
+  return covarianceOf(shape, points, all_points.size());
+}
+
+ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
+                                            const std::vector<Eigen::Vector3d>& all_points) const {
+  Result result;
   result.shape = shape;
-  result.rms = std::sqrt(cost / points.size());
-  if (eig.info() != Eigen::Success ||
-      eig.eigenvalues().minCoeff() <= 1e-12 * eig.eigenvalues().maxCoeff()) {
-    result.covariance = Eigen::MatrixXd::Identity(k, k) * 1e6;
+  if (static_cast<int>(all_points.size()) <= minimalDimension(shape.quadric_class))
     return result;
-  }
-  result.covariance = sigma2 * H.inverse();
-  result.ok = true;
-  return result;
+  return covarianceOf(shape, subsample(all_points, params_.max_points), all_points.size());
 }
 
 PrimitiveShape fitPlane(const std::vector<Eigen::Vector3d>& points) {

@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
   std::printf("frames: %zu real (%s), %zu synthetic; %d repeats each\n", real.size(), data.c_str(),
               synth.size(), repeats);
 
-  std::vector<double> real_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms;
+  std::vector<double> real_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms, upsample_ms;
   for (int r = 0; r < repeats; ++r) {
     for (const auto* set : {&real, &synth}) {
       for (const Frame& f : *set) {
@@ -206,6 +206,7 @@ int main(int argc, char** argv) {
         planes_ms.push_back(s.timings.planes_ms);
         ransac_ms.push_back(s.timings.ransac_ms);
         verify_ms.push_back(s.timings.verify_ms);
+        upsample_ms.push_back(s.timings.upsample_ms);
       }
     }
   }
@@ -231,6 +232,7 @@ int main(int argc, char** argv) {
   report("    stage: planes", planes_ms);
   report("    stage: ransac", ransac_ms);
   report("    stage: verification", verify_ms);
+  report("    stage: upsampling", upsample_ms);
   std::printf("Baseline, CGAL Efficient RANSAC, 4 shapes, full frame (%zu shapes total):\n",
               base_shapes);
   report("  baseline frames", base_ms);

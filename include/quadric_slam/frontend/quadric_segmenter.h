@@ -54,6 +54,7 @@ struct SegmentationTimings {
   double planes_ms = 0.0;     // region growing, merging and plane refinement
   double ransac_ms = 0.0;     // sub-sampling and CGAL Efficient RANSAC
   double verify_ms = 0.0;     // filters, refinement and re-assignment of curved candidates
+  double upsample_ms = 0.0;   // decimation and full-resolution labelling (decimation > 1)
   int ransac_points = 0;      // points given to CGAL
   int ransac_candidates = 0;  // shapes CGAL returned
 };
@@ -71,6 +72,10 @@ class QuadricSegmenter {
     // Points outside [min_range, max_range] of depth (z, m) are ignored. 0 < min < max.
     double min_range = 0.3;
     double max_range = 4.5;
+    // The segmentation runs on every decimation-th pixel in u and v (point counts and strides
+    // below are scaled accordingly) and the labels are then assigned at full resolution: each
+    // pixel takes a neighbouring sample's label when it fits that surface. [1, 8]. Default 2.
+    int decimation = 2;
     // Planes (region growing); its min_points is in points of the cloud grid.
     PlaneRegionGrower::Params planes;
     // Curved shapes.
@@ -101,8 +106,9 @@ class QuadricSegmenter {
     double min_cylinder_radius = 0.01, max_cylinder_radius = 0.5;
     double min_cone_half_angle = 0.05, max_cone_half_angle = 1.2;
     // Degeneracy: a curved fit whose RMS is not clearly better than a plane's (plane RMS <
-    // plane_rms_ratio * curved RMS) is a plane; a cone whose RMS is not clearly better than a
-    // cylinder's is a cylinder. Ratios >= 1.
+    // plane_rms_ratio * curved RMS) is a plane; a cone or cylinder whose RMS is not clearly
+    // better than that of a simpler class (cone -> cylinder -> sphere; RMS of the simpler <
+    // cylinder_rms_ratio * its own) becomes the simpler class. Ratios >= 1.
     double plane_rms_ratio = 1.5;
     double cylinder_rms_ratio = 1.15;
     // Largest fit RMS of a curved segment, relative to its distance threshold at the median

@@ -18,8 +18,8 @@ class ShapeRefiner {
     // Stop when the step's relative cost decrease is below this, (0, 1). Default 1e-6.
     double relative_tolerance = 1e-6;
     // Points used at most (an even sub-sample beyond this; the covariance is scaled back to all
-    // points), [10, 1e7]. Default 2000.
-    int max_points = 2000;
+    // points), [10, 1e7]. Default 1000.
+    int max_points = 1000;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -39,6 +39,9 @@ class ShapeRefiner {
   explicit ShapeRefiner(const Params& params);
 
   Result refine(const PrimitiveShape& initial, const std::vector<Eigen::Vector3d>& points) const;
+  // The covariance and RMS of shape on points without iterating (for an exact least-squares
+  // solution such as the PCA plane).
+  Result evaluate(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) const;
 
  private:
   Params params_;
