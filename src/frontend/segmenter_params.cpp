@@ -93,6 +93,15 @@ const std::vector<std::string>& segmenterParamNames() {
   return names;
 }
 
+SegmenterParamType segmenterParamType(const std::string& key) {
+  const Entry& e = find(key);
+  if (e.real)
+    return SegmenterParamType::kReal;
+  if (e.integer)
+    return SegmenterParamType::kInteger;
+  return SegmenterParamType::kBool;
+}
+
 double getSegmenterParam(const Params& params, const std::string& key) {
   const Entry& e = find(key);
   Params& p = const_cast<Params&>(params);  // the accessors only read here

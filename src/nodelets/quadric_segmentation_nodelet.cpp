@@ -111,9 +111,28 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
     ros_params::ParamLog log;
     QuadricSegmenter::Params params;
     for (const std::string& name : segmenterParamNames()) {
-      double value = getSegmenterParam(params, name);
-      ros_params::read(private_nh, name, value, log);
-      setSegmenterParam(params, name, value);
+      // Read with the key's own type (a bool read as a double would silently keep its default).
+      const double current = getSegmenterParam(params, name);
+      switch (segmenterParamType(name)) {
+        case SegmenterParamType::kReal: {
+          double value = current;
+          ros_params::read(private_nh, name, value, log);
+          setSegmenterParam(params, name, value);
+          break;
+        }
+        case SegmenterParamType::kInteger: {
+          int value = static_cast<int>(current);
+          ros_params::read(private_nh, name, value, log);
+          setSegmenterParam(params, name, value);
+          break;
+        }
+        case SegmenterParamType::kBool: {
+          bool value = current != 0.0;
+          ros_params::read(private_nh, name, value, log);
+          setSegmenterParam(params, name, value ? 1.0 : 0.0);
+          break;
+        }
+      }
     }
     int queue_size = 2;
     ros_params::read(private_nh, "queue_size", queue_size, log);

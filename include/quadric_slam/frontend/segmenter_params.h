@@ -11,6 +11,10 @@ namespace quadric_slam {
 
 // Every key of config/segmentation.yaml, in file order.
 const std::vector<std::string>& segmenterParamNames();
+enum class SegmenterParamType { kReal, kInteger, kBool };
+// The type of a key (ROS parameters and YAML values must have it). Throws std::invalid_argument
+// for an unknown key.
+SegmenterParamType segmenterParamType(const std::string& key);
 // Value of a key as a double (booleans 0/1, integers exactly). Throws std::invalid_argument for
 // an unknown key.
 double getSegmenterParam(const QuadricSegmenter::Params& params, const std::string& key);

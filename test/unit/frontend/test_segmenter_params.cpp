@@ -37,6 +37,10 @@ TEST(SegmenterParams, SetAndGetRoundTripAndUnknownKeysThrow) {
   EXPECT_FALSE(p.detect_cones);
   EXPECT_DOUBLE_EQ(qs::getSegmenterParam(p, "detect_cones"), 0.0);
   EXPECT_THROW(qs::setSegmenterParam(p, "no_such_key", 1), std::invalid_argument);
+  // The nodelet reads each key with its type: booleans must not be read as numbers.
+  EXPECT_EQ(qs::segmenterParamType("detect_cones"), qs::SegmenterParamType::kBool);
+  EXPECT_EQ(qs::segmenterParamType("cgal_stride"), qs::SegmenterParamType::kInteger);
+  EXPECT_EQ(qs::segmenterParamType("distance_factor"), qs::SegmenterParamType::kReal);
 
   const std::string bad = testing::TempDir() + "/bad_segmentation.yaml";
   std::ofstream(bad) << "cgal_stride: 3\nbogus: 1\n";
