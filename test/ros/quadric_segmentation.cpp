@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <vector>
 
 #include "quadric_slam/QuadricObservationArray.h"
@@ -99,8 +100,13 @@ TEST_F(QuadricSegmentationTest, ObservationsOfARenderedSceneAndBadInput) {
   ros::Subscriber image_sub = nh.subscribe<sensor_msgs::Image>(
       "/quadric_segmentation/segmentation_image", 2,
       [&images](const sensor_msgs::ImageConstPtr& image) { images.push_back(image); });
+  std::vector<sensor_msgs::PointCloud2ConstPtr> labelled;
+  ros::Subscriber labelled_sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      "/quadric_segmentation/segmented_cloud", 2,
+      [&labelled](const sensor_msgs::PointCloud2ConstPtr& cloud) { labelled.push_back(cloud); });
   const ros::WallTime wait = ros::WallTime::now() + ros::WallDuration(10.0);
-  while (image_sub.getNumPublishers() == 0 && ros::WallTime::now() < wait) {
+  while ((image_sub.getNumPublishers() == 0 || labelled_sub.getNumPublishers() == 0) &&
+         ros::WallTime::now() < wait) {
     ros::WallDuration(0.05).sleep();
     ros::spinOnce();
   }
@@ -156,6 +162,21 @@ TEST_F(QuadricSegmentationTest, ObservationsOfARenderedSceneAndBadInput) {
   EXPECT_EQ(images.back()->encoding, "rgb8");
   EXPECT_EQ(images.back()->width, 640u);
   EXPECT_EQ(images.back()->height, 480u);
+  while (labelled.empty() && ros::WallTime::now() < image_deadline) {
+    ros::WallDuration(0.02).sleep();
+    ros::spinOnce();
+  }
+  ASSERT_FALSE(labelled.empty()) << "no ~segmented_cloud while subscribed";
+  pcl::PointCloud<pcl::PointXYZL> labels;
+  pcl::fromROSMsg(*labelled.back(), labels);
+  ASSERT_EQ(labels.width, 640u);
+  ASSERT_EQ(labels.height, 480u);
+  std::map<std::uint32_t, std::uint32_t> counts;
+  for (const auto& p : labels.points)
+    ++counts[p.label];
+  // Every observation's label holds exactly its supporting points.
+  for (const qs::QuadricObservation& o : first->observations)
+    EXPECT_EQ(counts[o.label], o.num_points) << "label " << o.label;
 
   // An all-NaN cloud: an empty array with the same stamp.
   pcl::PointCloud<pcl::PointNormal> nan_cloud(640, 480);
