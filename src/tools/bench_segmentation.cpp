@@ -23,6 +23,7 @@
 #include "quadric_slam/frontend/primitive_scene_renderer.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/frontend/segmentation_input.h"
+#include "quadric_slam/frontend/segmenter_params.h"
 
 namespace qs = quadric_slam;
 namespace fs = std::filesystem;
@@ -170,6 +171,7 @@ void report(const char* name, const std::vector<double>& times) {
 int main(int argc, char** argv) {
   std::string data = QUADRIC_SLAM_SHARED_DATA_DIR;
   int repeats = 3, synthetic = 10, baseline_frames = 8;
+  qs::QuadricSegmenter::Params params;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i], value = argv[i + 1];
     if (arg == "--data")
@@ -180,15 +182,20 @@ int main(int argc, char** argv) {
       synthetic = std::atoi(value.c_str());
     else if (arg == "--baseline-frames")
       baseline_frames = std::atoi(value.c_str());
+    else if (arg == "--config")
+      params = qs::loadSegmenterParams(value);
+    else if (arg == "--set" && value.find('=') != std::string::npos)
+      qs::setSegmenterParam(params, value.substr(0, value.find('=')),
+                            std::atof(value.c_str() + value.find('=') + 1));
     else {
       std::fprintf(stderr,
                    "usage: bench_segmentation [--data DIR] [--repeats N] [--synthetic N] "
-                   "[--baseline-frames N]\n");
+                   "[--baseline-frames N] [--config segmentation.yaml] [--set KEY=VALUE]...\n");
       return 2;
     }
   }
   const qs::NormalEstimator normals{qs::NormalEstimator::Params()};
-  const qs::QuadricSegmenter segmenter{qs::QuadricSegmenter::Params()};
+  const qs::QuadricSegmenter segmenter(params);
   const std::vector<Frame> real = realFrames(data, normals);
   const std::vector<Frame> synth = syntheticFrames(synthetic, normals);
   std::printf("frames: %zu real (%s), %zu synthetic; %d repeats each\n", real.size(), data.c_str(),
