@@ -11,6 +11,23 @@
 namespace quadric_slam {
 namespace {
 
+// Runs fn(begin, end) over [0, count) split into `threads` contiguous chunks, one thread each.
+template <typename Fn>
+void forEachChunk(int count, int threads, Fn fn) {
+  threads = std::max(1, std::min(threads, count));
+  if (threads == 1) {
+    fn(0, count);
+    return;
+  }
+  std::vector<std::thread> workers;
+  for (int t = 1; t < threads; ++t) {
+    workers.emplace_back(fn, count * t / threads, count * (t + 1) / threads);
+  }
+  fn(0, count / threads);
+  for (auto& worker : workers)
+    worker.join();
+}
+
 // Summed-area table of (x, y, z, valid count) over an organized cloud, (W+1) x (H+1), interleaved
 // so that each box corner is one cache line, in double: float sums over a whole frame lose the
 // millimetres the differences need.
@@ -21,25 +38,40 @@ struct IntegralImages {
   int stride = 0;
   std::vector<Cell> cells;
 
-  explicit IntegralImages(const pcl::PointCloud<pcl::PointXYZ>& cloud)
+  // Built in two passes that each split over threads: prefix sums along every row, then
+  // accumulation down the columns.
+  IntegralImages(const pcl::PointCloud<pcl::PointXYZ>& cloud, int threads)
       : stride(static_cast<int>(cloud.width) + 1),
         cells(static_cast<std::size_t>(stride) * (cloud.height + 1), Cell{0, 0, 0, 0}) {
-    for (int v = 0; v < static_cast<int>(cloud.height); ++v) {
-      Cell row_sum{0, 0, 0, 0};
-      const Cell* above = &cells[static_cast<std::size_t>(v) * stride + 1];
-      Cell* here = &cells[static_cast<std::size_t>(v + 1) * stride + 1];
-      const pcl::PointXYZ* point = &cloud.points[static_cast<std::size_t>(v) * cloud.width];
-      for (int u = 0; u < static_cast<int>(cloud.width); ++u) {
-        if (std::isfinite(point[u].z)) {
-          row_sum.x += point[u].x;
-          row_sum.y += point[u].y;
-          row_sum.z += point[u].z;
-          row_sum.n += 1.0;
+    const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+    forEachChunk(height, threads, [&](int v_begin, int v_end) {
+      for (int v = v_begin; v < v_end; ++v) {
+        Cell sum{0, 0, 0, 0};
+        Cell* here = &cells[static_cast<std::size_t>(v + 1) * stride + 1];
+        const pcl::PointXYZ* point = &cloud.points[static_cast<std::size_t>(v) * width];
+        for (int u = 0; u < width; ++u) {
+          if (std::isfinite(point[u].z)) {
+            sum.x += point[u].x;
+            sum.y += point[u].y;
+            sum.z += point[u].z;
+            sum.n += 1.0;
+          }
+          here[u] = sum;
         }
-        here[u] = Cell{above[u].x + row_sum.x, above[u].y + row_sum.y, above[u].z + row_sum.z,
-                       above[u].n + row_sum.n};
       }
-    }
+    });
+    forEachChunk(width, threads, [&](int u_begin, int u_end) {
+      for (int v = 1; v < height; ++v) {
+        const Cell* above = &cells[static_cast<std::size_t>(v) * stride + 1];
+        Cell* here = &cells[static_cast<std::size_t>(v + 1) * stride + 1];
+        for (int u = u_begin; u < u_end; ++u) {
+          here[u].x += above[u].x;
+          here[u].y += above[u].y;
+          here[u].z += above[u].z;
+          here[u].n += above[u].n;
+        }
+      }
+    });
   }
 
   // Mean point over the inclusive pixel box [u0, u1] x [v0, v1]; false when less than min_fraction
@@ -60,30 +92,32 @@ struct IntegralImages {
 
 // Distance (pixels, L1) of every pixel to the nearest edge: a pixel without data or whose right or
 // lower neighbour jumps in depth by more than factor * depth.
-cv::Mat distanceToEdges(const pcl::PointCloud<pcl::PointXYZ>& cloud, double factor) {
+cv::Mat distanceToEdges(const pcl::PointCloud<pcl::PointXYZ>& cloud, double factor, int threads) {
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
   cv::Mat not_edge(height, width, CV_8UC1, cv::Scalar(255));
-  for (int v = 0; v < height; ++v) {
-    auto* row = not_edge.ptr<std::uint8_t>(v);
-    for (int u = 0; u < width; ++u) {
-      const float z = cloud(u, v).z;
-      if (!std::isfinite(z)) {
-        row[u] = 0;
-        continue;
-      }
-      const float limit = static_cast<float>(factor) * z;
-      if (u + 1 < width) {
-        const float right = cloud(u + 1, v).z;
-        if (std::isfinite(right) && std::abs(right - z) > limit)
+  forEachChunk(height, threads, [&](int v_begin, int v_end) {
+    for (int v = v_begin; v < v_end; ++v) {
+      auto* row = not_edge.ptr<std::uint8_t>(v);
+      for (int u = 0; u < width; ++u) {
+        const float z = cloud(u, v).z;
+        if (!std::isfinite(z)) {
           row[u] = 0;
-      }
-      if (v + 1 < height) {
-        const float below = cloud(u, v + 1).z;
-        if (std::isfinite(below) && std::abs(below - z) > limit)
-          row[u] = 0;
+          continue;
+        }
+        const float limit = static_cast<float>(factor) * z;
+        if (u + 1 < width) {
+          const float right = cloud(u + 1, v).z;
+          if (std::isfinite(right) && std::abs(right - z) > limit)
+            row[u] = 0;
+        }
+        if (v + 1 < height) {
+          const float below = cloud(u, v + 1).z;
+          if (std::isfinite(below) && std::abs(below - z) > limit)
+            row[u] = 0;
+        }
       }
     }
-  }
+  });
   cv::Mat distance;
   cv::distanceTransform(not_edge, distance, cv::DIST_L1, 3, CV_32F);
   return distance;
@@ -101,8 +135,9 @@ void computeBoxGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   if (width < 3 || height < 3)
     return;
 
-  const IntegralImages sums(cloud);
-  const cv::Mat distance = distanceToEdges(cloud, settings.max_depth_change_factor);
+  const IntegralImages sums(cloud, settings.threads);
+  const cv::Mat distance =
+      distanceToEdges(cloud, settings.max_depth_change_factor, settings.threads);
   // Each half of the box must be at least half full for its mean to be trusted.
   constexpr double kMinFraction = 0.5;
 
@@ -119,7 +154,9 @@ void computeBoxGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
         // Stay inside the image and away from edges: the box never straddles a discontinuity.
         const int r = std::min({static_cast<int>(half), static_cast<int>(dist_row[u]) - 1, u,
                                 width - 1 - u, v, height - 1 - v});
-        if (r < 1)
+        // Boxes squeezed by the image border or an edge to a few pixels give noisy normals (a
+        // few pixels' noise with a long lever arm): require a third of the full window.
+        if (r < std::max(2, static_cast<int>(half) / 3))
           continue;
         const int h = std::max(1, r / 2);
         Eigen::Vector3d left, right, up, down;
@@ -145,17 +182,7 @@ void computeBoxGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
     }
   };
 
-  const int threads = std::max(1, std::min(settings.threads, height));
-  if (threads == 1) {
-    process_rows(0, height);
-    return;
-  }
-  std::vector<std::thread> workers;
-  for (int t = 0; t < threads; ++t) {
-    workers.emplace_back(process_rows, height * t / threads, height * (t + 1) / threads);
-  }
-  for (auto& worker : workers)
-    worker.join();
+  forEachChunk(height, settings.threads, process_rows);
 }
 
 }  // namespace quadric_slam

@@ -64,7 +64,7 @@ struct Frame {
 std::vector<int> assignLargestComponent(const Frame& frame, const PrimitiveShape& shape,
                                         const ImageRoi& roi, const QuadricSegmenter::Params& p) {
   const double cos_angle = std::cos(p.curved_max_normal_angle);
-  const int x0 = roi.x, y0 = roi.y, w = roi.width, h = roi.height;
+  const int x0 = roi.x_offset, y0 = roi.y_offset, w = roi.width, h = roi.height;
   std::vector<std::uint8_t> candidate(static_cast<std::size_t>(w) * h, 0);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -160,8 +160,8 @@ ImageRoi roiOf(const std::vector<int>& indices, int width) {
   ImageRoi roi;
   if (x_max < 0)
     return roi;
-  roi.x = x_min;
-  roi.y = y_min;
+  roi.x_offset = x_min;
+  roi.y_offset = y_min;
   roi.width = x_max - x_min + 1;
   roi.height = y_max - y_min + 1;
   return roi;
@@ -169,10 +169,10 @@ ImageRoi roiOf(const std::vector<int>& indices, int width) {
 
 ImageRoi grown(const ImageRoi& roi, int margin, int width, int height) {
   ImageRoi g;
-  g.x = std::max(0, roi.x - margin);
-  g.y = std::max(0, roi.y - margin);
-  g.width = std::min(width, roi.x + roi.width + margin) - g.x;
-  g.height = std::min(height, roi.y + roi.height + margin) - g.y;
+  g.x_offset = std::max(0, roi.x_offset - margin);
+  g.y_offset = std::max(0, roi.y_offset - margin);
+  g.width = std::min(width, roi.x_offset + roi.width + margin) - g.x_offset;
+  g.height = std::min(height, roi.y_offset + roi.height + margin) - g.y_offset;
   return g;
 }
 
@@ -526,8 +526,8 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
       const Eigen::Vector3d local = T_quadric_camera[k] * point;
       lo[k] = lo[k].cwiseMin(local);
       hi[k] = hi[k].cwiseMax(local);
-      box[k].x = std::min(box[k].x, u);
-      box[k].y = std::min(box[k].y, v);
+      box[k].x_offset = std::min(box[k].x_offset, u);
+      box[k].y_offset = std::min(box[k].y_offset, v);
       box[k].width = std::max(box[k].width, u);
       box[k].height = std::max(box[k].height, v);
     }
@@ -545,8 +545,8 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
     detection.num_points = count[k];
     detection.extent_min = lo[k];
     detection.extent_max = hi[k];
-    detection.roi =
-        ImageRoi{box[k].x, box[k].y, box[k].width - box[k].x + 1, box[k].height - box[k].y + 1};
+    detection.roi = ImageRoi{box[k].x_offset, box[k].y_offset, box[k].width - box[k].x_offset + 1,
+                             box[k].height - box[k].y_offset + 1};
     result.detections.push_back(std::move(detection));
   }
   for (int v = 0; v < height; ++v)

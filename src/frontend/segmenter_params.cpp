@@ -122,6 +122,18 @@ void setSegmenterParam(Params& params, const std::string& key, double value) {
     e.flag(params) = value != 0.0;
 }
 
+void readSegmentationParams(const ParamReader& reader, Params& params, ParamLog& log) {
+  for (const Entry& e : table()) {
+    if (e.real)
+      readParam(reader, e.name, e.real(params), log);
+    else if (e.integer)
+      readParam(reader, e.name, e.integer(params), log);
+    else
+      readParam(reader, e.name, e.flag(params), log);
+  }
+  params.validate();
+}
+
 QuadricSegmenter::Params loadSegmenterParams(const std::string& yaml_path) {
   YAML::Node root;
   try {

@@ -20,6 +20,7 @@
 
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/io/pipeline_params.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/params.h"
@@ -32,22 +33,13 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& private_nh = getPrivateNodeHandle();
 
-    ros_params::ParamLog log;
+    ParamLog log;
     NormalEstimator::Params normal_params;
-    ros_params::read(private_nh, "decimation", back_projection_.decimation, log);
-    ros_params::read(private_nh, "min_range", back_projection_.min_range, log);
-    ros_params::read(private_nh, "max_range", back_projection_.max_range, log);
-    ros_params::read(private_nh, "normal_method", normal_params.method, log);
-    ros_params::read(private_nh, "max_depth_change_factor", normal_params.max_depth_change_factor,
-                     log);
-    ros_params::read(private_nh, "normal_smoothing_size", normal_params.normal_smoothing_size, log);
-    ros_params::read(private_nh, "depth_dependent_smoothing",
-                     normal_params.depth_dependent_smoothing, log);
-    ros_params::read(private_nh, "threads", normal_params.threads, log);
     int queue_size = 5;
-    ros_params::read(private_nh, "queue_size", queue_size, log);
     try {
-      back_projection_.validate();
+      const RosParamReader params(private_nh);
+      readNormalEstimationParams(params, back_projection_, normal_params, log);
+      readParam(params, "queue_size", queue_size, log);
       estimator_ = std::make_unique<NormalEstimator>(normal_params);
     } catch (const std::invalid_argument& e) {
       NODELET_FATAL("normal_estimation: invalid parameter: %s", e.what());

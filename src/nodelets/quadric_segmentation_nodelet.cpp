@@ -72,8 +72,8 @@ QuadricObservation toMessage(const QuadricDetection& d) {
       o.covariance.push_back(d.covariance(r, col));
   o.num_points = static_cast<std::uint32_t>(d.num_points);
   o.label = d.label;
-  o.image_roi.x_offset = static_cast<std::uint32_t>(d.roi.x);
-  o.image_roi.y_offset = static_cast<std::uint32_t>(d.roi.y);
+  o.image_roi.x_offset = static_cast<std::uint32_t>(d.roi.x_offset);
+  o.image_roi.y_offset = static_cast<std::uint32_t>(d.roi.y_offset);
   o.image_roi.width = static_cast<std::uint32_t>(d.roi.width);
   o.image_roi.height = static_cast<std::uint32_t>(d.roi.height);
   o.fit_rms = static_cast<float>(d.fit_rms);
@@ -108,35 +108,13 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
     ros::NodeHandle& nh = getNodeHandle();
     ros::NodeHandle& private_nh = getPrivateNodeHandle();
 
-    ros_params::ParamLog log;
+    ParamLog log;
     QuadricSegmenter::Params params;
-    for (const std::string& name : segmenterParamNames()) {
-      // Read with the key's own type (a bool read as a double would silently keep its default).
-      const double current = getSegmenterParam(params, name);
-      switch (segmenterParamType(name)) {
-        case SegmenterParamType::kReal: {
-          double value = current;
-          ros_params::read(private_nh, name, value, log);
-          setSegmenterParam(params, name, value);
-          break;
-        }
-        case SegmenterParamType::kInteger: {
-          int value = static_cast<int>(current);
-          ros_params::read(private_nh, name, value, log);
-          setSegmenterParam(params, name, value);
-          break;
-        }
-        case SegmenterParamType::kBool: {
-          bool value = current != 0.0;
-          ros_params::read(private_nh, name, value, log);
-          setSegmenterParam(params, name, value ? 1.0 : 0.0);
-          break;
-        }
-      }
-    }
     int queue_size = 2;
-    ros_params::read(private_nh, "queue_size", queue_size, log);
     try {
+      const RosParamReader reader(private_nh);
+      readSegmentationParams(reader, params, log);
+      readParam(reader, "queue_size", queue_size, log);
       segmenter_ = std::make_unique<QuadricSegmenter>(params);
     } catch (const std::invalid_argument& e) {
       NODELET_FATAL("quadric_segmentation: invalid parameter: %s", e.what());

@@ -22,16 +22,12 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "quadric_slam/frontend/observation.h"  // ImageRoi
 #include "quadric_slam/frontend/plane_region_grower.h"
 #include "quadric_slam/frontend/primitive_shape.h"
 #include "quadric_slam/frontend/shape_refiner.h"
 
 namespace quadric_slam {
-
-// Pixel bounding box in the organized cloud's grid.
-struct ImageRoi {
-  int x = 0, y = 0, width = 0, height = 0;
-};
 
 // One segmented primitive, in the frame of the input cloud (the camera frame).
 struct QuadricDetection {
@@ -44,7 +40,7 @@ struct QuadricDetection {
   int num_points = 0;    // supporting points (cloud grid)
   double fit_rms = 0.0;  // RMS geometric distance of the supporting points (m)
   std::uint16_t label = 0;
-  ImageRoi roi;
+  ImageRoi roi;  // bounding box of the supporting pixels in the cloud's grid
   // Axis-aligned box of the supporting points in the quadric frame of shape.poseInFrame() (m).
   Eigen::Vector3d extent_min = Eigen::Vector3d::Zero(), extent_max = Eigen::Vector3d::Zero();
 };

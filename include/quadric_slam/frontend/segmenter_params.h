@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "quadric_slam/frontend/quadric_segmenter.h"
+#include "quadric_slam/io/param_reader.h"
 
 namespace quadric_slam {
 
@@ -21,6 +22,11 @@ double getSegmenterParam(const QuadricSegmenter::Params& params, const std::stri
 // Sets a key (integers are rounded, booleans are value != 0). Throws std::invalid_argument for an
 // unknown key. Call params.validate() afterwards.
 void setSegmenterParam(QuadricSegmenter::Params& params, const std::string& key, double value);
+// Reads every key of the table present in reader (private ROS parameters or a YAML file) with its
+// type (real, integer or boolean), keeping defaults for the others, logs the effective values and
+// validates (std::invalid_argument naming the bad field or a key of the wrong type).
+void readSegmentationParams(const ParamReader& reader, QuadricSegmenter::Params& params,
+                            ParamLog& log);
 // Reads the keys present in a YAML file of the config/segmentation.yaml form (unknown keys throw
 // std::invalid_argument naming them; absent keys keep their defaults); validates.
 QuadricSegmenter::Params loadSegmenterParams(const std::string& yaml_path);

@@ -1,33 +1,36 @@
-// Reading private parameters with their defaults, and logging the effective values once.
+// Private ROS parameters as a ParamReader, so nodelets read the same key tables
+// (io/pipeline_params.h) as the offline tools read from config/*.yaml.
 #pragma once
 
 #include <ros/node_handle.h>
 
-#include <sstream>
 #include <string>
 
-namespace quadric_slam {
-namespace ros_params {
+#include "quadric_slam/io/param_reader.h"
 
-// Collects "name: value" lines while parameters are read, for one start-up log line.
-class ParamLog {
+namespace quadric_slam {
+
+class RosParamReader : public ParamReader {
  public:
-  template <typename T>
-  void add(const std::string& name, const T& value) {
-    text_ << "\n  " << name << ": " << value;
-  }
-  std::string str() const { return text_.str(); }
+  explicit RosParamReader(const ros::NodeHandle& private_nh) : nh_(private_nh) {}
+
+  bool get(const std::string& key, double& value) const override { return read(key, value); }
+  bool get(const std::string& key, int& value) const override { return read(key, value); }
+  bool get(const std::string& key, bool& value) const override { return read(key, value); }
+  bool get(const std::string& key, std::string& value) const override { return read(key, value); }
 
  private:
-  std::ostringstream text_;
+  template <typename T>
+  bool read(const std::string& key, T& value) const {
+    if (!nh_.hasParam(key))
+      return false;
+    if (!nh_.getParam(key, value)) {
+      throw std::invalid_argument("parameter '" + nh_.resolveName(key) + "' has the wrong type");
+    }
+    return true;
+  }
+
+  ros::NodeHandle nh_;
 };
 
-// Reads ~name into value (keeping value as the default when unset) and records it in log.
-template <typename T>
-void read(const ros::NodeHandle& private_nh, const std::string& name, T& value, ParamLog& log) {
-  private_nh.param(name, value, value);
-  log.add(name, value);
-}
-
-}  // namespace ros_params
 }  // namespace quadric_slam

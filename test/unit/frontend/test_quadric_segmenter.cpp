@@ -198,10 +198,10 @@ TEST(QuadricSegmenter, LabelsAreConsistentWithDetections) {
     for (int y = 0; y < result.labels.rows; ++y)
       for (int x = 0; x < result.labels.cols; ++x)
         if (result.labels.at<std::uint16_t>(y, x) == d.label) {
-          ASSERT_GE(x, d.roi.x);
-          ASSERT_LT(x, d.roi.x + d.roi.width);
-          ASSERT_GE(y, d.roi.y);
-          ASSERT_LT(y, d.roi.y + d.roi.height);
+          ASSERT_GE(x, d.roi.x_offset);
+          ASSERT_LT(x, d.roi.x_offset + d.roi.width);
+          ASSERT_GE(y, d.roi.y_offset);
+          ASSERT_LT(y, d.roi.y_offset + d.roi.height);
         }
     EXPECT_TRUE((d.extent_max.array() >= d.extent_min.array()).all());
   }

@@ -1,0 +1,28 @@
+// The parameter key tables of the pipeline's core classes: the same keys are read by the nodelets
+// (private ROS parameters) and by the offline tools (config/*.yaml). Each function reads the keys
+// present, keeps defaults for the rest, logs the effective values and validates (throwing
+// std::invalid_argument naming the bad field).
+#pragma once
+
+#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/io/param_reader.h"
+#include "quadric_slam/odometry/odometry_tracker.h"
+
+namespace quadric_slam {
+
+// config/normal_estimation.yaml: decimation, min_range, max_range (back-projection) and
+// normal_method, max_depth_change_factor, normal_smoothing_size, depth_dependent_smoothing,
+// threads.
+void readNormalEstimationParams(const ParamReader& reader, BackProjectionParams& back_projection,
+                                NormalEstimator::Params& normals, ParamLog& log);
+
+// config/odometry.yaml, the tracker and ICP keys: pyramid_levels, finest_stride, reference_stride,
+// max_iterations, max_correspondence_distance, coarse_distance_factor, max_normal_angle,
+// depth_noise_weighting, huber_delta, convergence_translation, convergence_rotation,
+// min_correspondences, min_eigenvalue_ratio, degenerate_variance, max_translation_from_guess,
+// max_rotation_from_guess, keyframe_translation, keyframe_rotation, keyframe_min_overlap,
+// constant_velocity, lost_frames_before_new_keyframe.
+void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& params, ParamLog& log);
+
+}  // namespace quadric_slam

@@ -1,0 +1,81 @@
+// Frame-to-keyframe visual odometry on organized clouds with normals: owns the keyframe, the
+// constant-velocity prior and the pose T_odom_camera. The odometry nodelet and offline runners
+// both call track() once per frame.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/odometry/point_to_plane_icp.h"
+
+namespace quadric_slam {
+
+class OdometryTracker {
+ public:
+  using Cloud = PointToPlaneIcp::Cloud;
+  using Matrix6 = pose_math::Matrix6;
+
+  struct Params {
+    PointToPlaneIcp::Params icp;
+    // A new keyframe is taken when the camera has moved more than this from the keyframe (m). > 0
+    double keyframe_translation = 0.10;
+    // ... or turned more than this (rad). (0, pi]
+    double keyframe_rotation = 0.1745;
+    // ... or when the inlier fraction (overlap with the keyframe) drops below this. [0, 1]
+    double keyframe_min_overlap = 0.5;
+    // Predict each frame with the last inter-frame motion (scaled by the time step) instead of the
+    // last pose.
+    bool constant_velocity = true;
+    // After this many consecutive lost frames the current frame becomes the keyframe (at the last
+    // pose), so tracking can resume. [1, 1000]
+    int lost_frames_before_new_keyframe = 3;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  struct Result {
+    Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();
+    // Covariance of (dx, dy, dz, rx, ry, rz): the position error and the small rotation error
+    // R_true = exp(r^) R, both in the odom frame (nav_msgs/Odometry pose covariance order).
+    Matrix6 covariance = Matrix6::Zero();
+    TrackingStatus status = TrackingStatus::kLost;
+    bool new_keyframe = false;    // this frame became the keyframe
+    int consecutive_lost = 0;     // lost frames in a row, this one included
+    PointToPlaneIcp::Result icp;  // details of the alignment (empty for the first frame)
+  };
+
+  explicit OdometryTracker(const Params& params);
+
+  // Tracks one organized cloud with normals (camera frame) taken at stamp (s). intrinsics are those
+  // of the full-resolution image the cloud was made from (it may be decimated). The first usable
+  // frame defines the odom frame (T_odom_camera = identity). Throws std::invalid_argument only when
+  // the cloud's size does not fit the intrinsics; bad data otherwise gives status lost.
+  Result track(const Cloud& cloud, const CameraIntrinsics& intrinsics, double stamp);
+
+  // Forgets the keyframe, pose and velocity: the next usable frame starts a new odom frame.
+  void reset();
+
+  bool initialized() const { return initialized_; }
+  const Eigen::Isometry3d& pose() const { return T_odom_camera_; }
+  const Params& params() const { return params_; }
+
+ private:
+  void setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics);
+  Result output(TrackingStatus status, bool new_keyframe) const;
+
+  Params params_;
+  PointToPlaneIcp icp_;
+  bool initialized_ = false;
+  Eigen::Isometry3d T_odom_keyframe_ = Eigen::Isometry3d::Identity();
+  Matrix6 keyframe_covariance_ = Matrix6::Zero();  // left perturbation in odom, (v, omega)
+  Eigen::Isometry3d T_odom_camera_ = Eigen::Isometry3d::Identity();
+  Matrix6 covariance_ = Matrix6::Zero();  // left perturbation in odom, (v, omega)
+  Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();  // T_prev_cur of the last step
+  double last_dt_ = 0;
+  double last_stamp_ = 0;
+  int consecutive_lost_ = 0;
+};
+
+}  // namespace quadric_slam

@@ -1,0 +1,149 @@
+// Point-to-plane ICP between two organized clouds with normals: projective data association into
+// the reference's image grid, coarse-to-fine over subsampled pyramid levels, distance and
+// normal-angle gates, Huber weights and Gauss-Newton on SE(3), with degeneracy detection.
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/odometry/pose_math.h"
+
+namespace quadric_slam {
+
+// Outcome of one tracking step.
+enum class TrackingStatus {
+  kOk,          // all six degrees of freedom constrained by the data
+  kDegenerate,  // some directions unconstrained (e.g. a single plane): those keep the prior
+  kLost,        // too few correspondences or an implausible result: the prior is returned
+};
+const char* toString(TrackingStatus status);
+
+// Decimation factor d of an organized cloud made from an image of the intrinsics' size (as
+// backProject does: width / d x height / d). Returns 0 and sets *problem when they do not fit.
+int organizedCloudDecimation(const CameraIntrinsics& intrinsics, int cloud_width, int cloud_height,
+                             std::string* problem);
+
+class PointToPlaneIcp {
+ public:
+  using Cloud = pcl::PointCloud<pcl::PointNormal>;
+  using Matrix6 = pose_math::Matrix6;
+  using Vector6 = pose_math::Vector6;
+
+  struct Params {
+    // Pyramid levels; level l samples every (finest_stride * 2^l)-th point of the current cloud in
+    // u and v, and runs before level l - 1 (coarse to fine). [1, 6]
+    int pyramid_levels = 3;
+    // Sampling step of the current cloud at the finest level (cloud pixels). [1, 32]
+    int finest_stride = 4;
+    // The reference keeps every n-th point in u and v, packed (24 bytes a point) so that it stays
+    // in cache: 2 turns a 640 x 480 keyframe into 1.8 MB. Projective association picks the nearest
+    // kept point; point-to-plane residuals hardly depend on which point of the plane it is. [1, 16]
+    int reference_stride = 2;
+    // Gauss-Newton iterations at most per level. [1, 100]
+    int max_iterations = 10;
+    // Distance gate between a transformed current point and its reference point at the finest
+    // level (m); level l uses max_correspondence_distance * coarse_distance_factor^l. (0, 10]
+    double max_correspondence_distance = 0.05;
+    double coarse_distance_factor = 2.0;  // [1, 10]
+    // Normal-angle gate between the rotated current normal and the reference normal (rad). (0, pi]
+    double max_normal_angle = 0.5236;
+    // Weight residuals by the depth-noise model of structured-light sensors, sigma(z) ~ z^2
+    // (Khoshelham & Elberink 2012): residuals are divided by (z / 1 m)^2 of the reference point,
+    // z clamped to at least 0.5 m. Off: every correspondence has the same weight.
+    bool depth_noise_weighting = true;
+    // Huber threshold on the (depth-normalised, when depth_noise_weighting) point-to-plane
+    // residual (m at 1 m depth). (0, 1]
+    double huber_delta = 0.005;
+    // Convergence: stop the finest level when the update is below both (m, rad); level l uses
+    // 4^l times these (it has 4^l times fewer points). > 0
+    double convergence_translation = 1e-4;
+    double convergence_rotation = 1e-4;
+    // Fewer inlier correspondences than this at the finest level means lost (coarse levels need
+    // min_correspondences / 4^l, at least 12). [6, 1e7]
+    int min_correspondences = 200;
+    // A direction of H whose eigenvalue is below min_eigenvalue_ratio * largest eigenvalue is
+    // unconstrained: the update leaves it at the prior and the status is degenerate. (0, 1)
+    double min_eigenvalue_ratio = 1e-3;
+    // Variance given to unconstrained directions in the covariance (m^2 or rad^2). > 0
+    double degenerate_variance = 1.0;
+    // A result further than this from the initial guess is implausible: lost (m, rad). > 0
+    double max_translation_from_guess = 0.3;
+    double max_rotation_from_guess = 0.5;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  struct Result {
+    Eigen::Isometry3d T_reference_current = Eigen::Isometry3d::Identity();
+    // Covariance of the left perturbation xi = (v, omega) in the reference frame,
+    // T = exp(xi^) T_hat: sigma^2 H^-1 with sigma^2 the weighted residual variance.
+    Matrix6 covariance = Matrix6::Identity();
+    TrackingStatus status = TrackingStatus::kLost;
+    int candidate_points = 0;  // usable sampled current points at the finest level
+    int correspondences = 0;   // inliers at the finest level
+    double inlier_fraction = 0;
+    double rms_residual = 0;  // point-to-plane RMS at the finest level (m; depth-normalised to
+                              // 1 m when depth_noise_weighting)
+    int iterations = 0;       // Gauss-Newton iterations over all levels
+    int constrained_dof = 0;  // 6 unless degenerate
+    // Smallest over largest eigenvalue of H at the finest level (1: evenly constrained, 0: a free
+    // direction); compared with Params::min_eigenvalue_ratio.
+    double eigenvalue_ratio = 0;
+    std::string message;  // why the status is not ok (empty when ok)
+  };
+
+  explicit PointToPlaneIcp(const Params& params);
+
+  // Sets the reference (keyframe): an organized cloud in its camera frame, and the intrinsics of
+  // the full-resolution image it came from (the cloud may be decimated by an integer factor).
+  // Copies what it needs (every reference_stride-th point, packed). Throws std::invalid_argument
+  // when the sizes do not fit.
+  void setReference(const Cloud& reference, const CameraIntrinsics& intrinsics);
+  bool hasReference() const { return has_reference_; }
+  void clearReference() { has_reference_ = false; }
+
+  // Aligns an organized current cloud to the reference, starting from T_reference_current_guess
+  // (the prior). Never throws on bad data: an empty or unusable cloud gives status lost.
+  Result align(const Cloud& current, const Eigen::Isometry3d& T_reference_current_guess);
+
+  // Number of points align() would sample at the finest level (finite point and normal).
+  int usablePoints(const Cloud& current) const;
+
+  const Params& params() const { return params_; }
+
+ private:
+  struct Sample {
+    Eigen::Vector3f p, n;
+    int grid_u, grid_v;  // position in the finest sampling grid
+  };
+  struct RefPoint {
+    float x, y, z, nx, ny, nz;  // z NaN where the reference has no point or no normal
+  };
+  struct Normals {
+    Matrix6 H;
+    Vector6 b;
+    double weighted_sq = 0;
+    int count = 0;
+  };
+  void sampleFinest(const Cloud& current);
+  void selectLevel(int level);
+  void accumulate(const Eigen::Isometry3d& T, double max_distance, Normals& eq) const;
+
+  Params params_;
+  double cos_max_normal_angle_;
+  bool has_reference_ = false;
+  std::vector<RefPoint> reference_;  // packed reference grid, row-major
+  int ref_w_ = 0, ref_h_ = 0;
+  float fx_ = 0, fy_ = 0, cx_ = 0, cy_ = 0;  // intrinsics in reference grid cells
+  // Buffers reused between calls (no allocation per iteration, none per frame once warm).
+  std::vector<Sample> finest_samples_, samples_;
+};
+
+}  // namespace quadric_slam

@@ -1,0 +1,41 @@
+#include "quadric_slam/io/param_reader.h"
+
+#include <stdexcept>
+
+namespace quadric_slam {
+
+YamlParamReader YamlParamReader::fromFile(const std::string& path) {
+  try {
+    YAML::Node root = YAML::LoadFile(path);
+    if (root && !root.IsMap() && !root.IsNull()) {
+      throw std::runtime_error("not a YAML mapping of parameters");
+    }
+    return YamlParamReader(root);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error("cannot read parameter file " + path + ": " + e.what());
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("parameter file " + path + ": " + e.what());
+  }
+}
+
+template <typename T>
+bool YamlParamReader::read(const std::string& key, T& value) const {
+  if (!root_ || !root_.IsMap())
+    return false;
+  const YAML::Node node = root_[key];
+  if (!node)
+    return false;
+  try {
+    value = node.as<T>();
+  } catch (const YAML::Exception&) {
+    throw std::invalid_argument("parameter '" + key + "' has the wrong type");
+  }
+  return true;
+}
+
+template bool YamlParamReader::read(const std::string&, double&) const;
+template bool YamlParamReader::read(const std::string&, int&) const;
+template bool YamlParamReader::read(const std::string&, bool&) const;
+template bool YamlParamReader::read(const std::string&, std::string&) const;
+
+}  // namespace quadric_slam

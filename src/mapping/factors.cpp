@@ -1,0 +1,140 @@
+#include "quadric_slam/mapping/factors.h"
+
+#include <Eigen/Cholesky>
+#include <stdexcept>
+#include <string>
+
+#include "quadric_slam/geometry/manifolds.h"
+#include "quadric_slam/geometry/quadric_classes.h"
+#include "quadric_slam/geometry/symmetry.h"
+
+namespace quadric_slam {
+
+namespace {
+using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+}  // namespace
+
+Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& covariance, const char* what) {
+  if (covariance.rows() != covariance.cols() || covariance.rows() == 0)
+    throw std::invalid_argument(std::string(what) + ": covariance must be square and non-empty");
+  if (!covariance.allFinite() || (covariance - covariance.transpose()).cwiseAbs().maxCoeff() >
+                                     1e-9 * covariance.cwiseAbs().maxCoeff())
+    throw std::invalid_argument(std::string(what) + ": covariance must be finite and symmetric");
+  const Eigen::LLT<Eigen::MatrixXd> llt_cov(covariance);
+  if (llt_cov.info() != Eigen::Success)
+    throw std::invalid_argument(std::string(what) + ": covariance must be positive definite");
+  const Eigen::MatrixXd information =
+      llt_cov.solve(Eigen::MatrixXd::Identity(covariance.rows(), covariance.cols()));
+  const Eigen::LLT<Eigen::MatrixXd> llt(0.5 * (information + information.transpose()));
+  return llt.matrixU();
+}
+
+QuadricObservationCost::QuadricObservationCost(const QuadricModel& z_camera,
+                                               const Eigen::MatrixXd& sqrt_information)
+    : z_(z_camera), T_quadric_camera_z_(z_camera.pose().inverse()) {
+  const int k = classDefinition(z_camera.quadricClass()).minimal_dimension;
+  if (sqrt_information.rows() != k || sqrt_information.cols() != k)
+    throw std::invalid_argument("QuadricObservationCost: sqrt_information must be " +
+                                std::to_string(k) + "x" + std::to_string(k) + " for a " +
+                                toString(z_camera.quadricClass()));
+  sqrt_information_ = sqrt_information;
+  basis_pinv_ = basisPseudoInverse(z_camera.quadricClass());
+  set_num_residuals(k);
+  mutable_parameter_block_sizes()->push_back(kPoseParameterSize);
+  mutable_parameter_block_sizes()->push_back(kQuadricParameterSize);
+}
+
+ceres::CostFunction* QuadricObservationCost::Create(const QuadricModel& z_camera,
+                                                    const Eigen::MatrixXd& covariance) {
+  return new QuadricObservationCost(z_camera,
+                                    sqrtInformation(covariance, "QuadricObservationCost"));
+}
+
+bool QuadricObservationCost::Evaluate(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  const QuadricClass c = z_.quadricClass();
+  const Eigen::Isometry3d T_world_camera = poseFromParameters(parameters[0]);
+  const Eigen::Isometry3d T_world_quadric = poseFromParameters(parameters[1]);
+  const Eigen::Vector3d scale(parameters[1][7], parameters[1][8], parameters[1][9]);
+  const Eigen::Isometry3d h = T_world_camera.inverse() * T_world_quadric;  // eq. 19
+  const Eigen::Isometry3d D = T_quadric_camera_z_ * h;
+  const Eigen::Isometry3d G = symmetryAlignment(c, D);
+  Vector9d r9;
+  r9.head<6>() = logSE3(G.inverse() * D);  // eq. 14: h [-] z G
+  r9.tail<3>() = scale - z_.scale();       // eq. 17
+  const Eigen::MatrixXd LM = sqrt_information_ * minimalAdjoint(c, G);
+  const int k = num_residuals();
+  Eigen::Map<Eigen::VectorXd>(residuals, k) = LM * (basis_pinv_ * r9);
+  if (jacobians == nullptr)
+    return true;
+  const Vector6d e = r9.head<6>();
+  const Matrix6d K = alignedErrorJacobian(c, e);
+  // d r / d delta (D exp(delta^)), k x 6: the error's rate and the whitening's rate through G.
+  Eigen::Matrix<double, 9, 6> de9 = Eigen::Matrix<double, 9, 6>::Zero();
+  de9.topRows<6>() = K;
+  Eigen::Matrix<double, 9, 6> dM9 = Eigen::Matrix<double, 9, 6>::Zero();
+  dM9.topRows<6>() = adjointSE3(G) * adSE3(e) * alignmentGeneratorRate(c, e);
+  const Eigen::MatrixXd LN = LM * basis_pinv_ * de9 - sqrt_information_ * basis_pinv_ * dM9;
+  if (jacobians[0] != nullptr) {
+    Eigen::Map<RowMajorMatrix>(jacobians[0], k, kPoseParameterSize) =
+        -LN * adjointSE3(h.inverse()) * poseMinusJacobian(parameters[0]);
+  }
+  if (jacobians[1] != nullptr) {
+    Eigen::MatrixXd dr_dq9(k, 9);
+    dr_dq9.leftCols<6>() = LN;
+    dr_dq9.rightCols<3>() = LM * basis_pinv_.rightCols<3>();
+    Eigen::Map<RowMajorMatrix>(jacobians[1], k, kQuadricParameterSize) =
+        dr_dq9 * quadricGeneralMinusJacobian(parameters[1]);
+  }
+  return true;
+}
+
+RelativePoseCost::RelativePoseCost(const Eigen::Isometry3d& T_i_j, const Matrix6d& sqrt_information)
+    : T_j_i_measured_(T_i_j.inverse()), sqrt_information_(sqrt_information) {}
+
+ceres::CostFunction* RelativePoseCost::Create(const Eigen::Isometry3d& T_i_j,
+                                              const Matrix6d& covariance) {
+  return new RelativePoseCost(T_i_j, sqrtInformation(covariance, "RelativePoseCost"));
+}
+
+bool RelativePoseCost::Evaluate(double const* const* parameters, double* residuals,
+                                double** jacobians) const {
+  const Eigen::Isometry3d T_w_i = poseFromParameters(parameters[0]);
+  const Eigen::Isometry3d T_w_j = poseFromParameters(parameters[1]);
+  const Eigen::Isometry3d T_i_j = T_w_i.inverse() * T_w_j;
+  const Vector6d e = logSE3(T_j_i_measured_ * T_i_j);
+  Eigen::Map<Vector6d>{residuals} = sqrt_information_ * e;
+  if (jacobians == nullptr)
+    return true;
+  const Matrix6d LJ = sqrt_information_ * rightJacobianInverseSE3(e);
+  using RowMajor67 = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
+  if (jacobians[0] != nullptr)
+    Eigen::Map<RowMajor67>{jacobians[0]} =
+        -LJ * adjointSE3(T_i_j.inverse()) * poseMinusJacobian(parameters[0]);
+  if (jacobians[1] != nullptr)
+    Eigen::Map<RowMajor67>{jacobians[1]} = LJ * poseMinusJacobian(parameters[1]);
+  return true;
+}
+
+PosePriorCost::PosePriorCost(const Eigen::Isometry3d& T_prior, const Matrix6d& sqrt_information)
+    : T_prior_inverse_(T_prior.inverse()), sqrt_information_(sqrt_information) {}
+
+ceres::CostFunction* PosePriorCost::Create(const Eigen::Isometry3d& T_prior,
+                                           const Matrix6d& covariance) {
+  return new PosePriorCost(T_prior, sqrtInformation(covariance, "PosePriorCost"));
+}
+
+bool PosePriorCost::Evaluate(double const* const* parameters, double* residuals,
+                             double** jacobians) const {
+  const Eigen::Isometry3d T = poseFromParameters(parameters[0]);
+  const Vector6d e = logSE3(T_prior_inverse_ * T);
+  Eigen::Map<Vector6d>{residuals} = sqrt_information_ * e;
+  if (jacobians != nullptr && jacobians[0] != nullptr) {
+    using RowMajor67 = Eigen::Matrix<double, 6, 7, Eigen::RowMajor>;
+    Eigen::Map<RowMajor67>{jacobians[0]} =
+        sqrt_information_ * rightJacobianInverseSE3(e) * poseMinusJacobian(parameters[0]);
+  }
+  return true;
+}
+
+}  // namespace quadric_slam

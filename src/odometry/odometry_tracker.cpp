@@ -1,0 +1,131 @@
+#include "quadric_slam/odometry/odometry_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace quadric_slam {
+
+void OdometryTracker::Params::validate() const {
+  icp.validate();
+  auto fail = [](const std::string& field, const std::string& range, double value) {
+    std::ostringstream why;
+    why << field << " must be in " << range << ", got " << value;
+    throw std::invalid_argument(why.str());
+  };
+  if (!(keyframe_translation > 0 && std::isfinite(keyframe_translation)))
+    fail("keyframe_translation", "(0, inf) m", keyframe_translation);
+  if (!(keyframe_rotation > 0 && keyframe_rotation <= M_PI))
+    fail("keyframe_rotation", "(0, pi] rad", keyframe_rotation);
+  if (!(keyframe_min_overlap >= 0 && keyframe_min_overlap <= 1))
+    fail("keyframe_min_overlap", "[0, 1]", keyframe_min_overlap);
+  if (lost_frames_before_new_keyframe < 1 || lost_frames_before_new_keyframe > 1000)
+    fail("lost_frames_before_new_keyframe", "[1, 1000]", lost_frames_before_new_keyframe);
+}
+
+OdometryTracker::OdometryTracker(const Params& params)
+    : params_((params.validate(), params)), icp_(params.icp) {}
+
+void OdometryTracker::reset() {
+  initialized_ = false;
+  icp_.clearReference();
+  T_odom_keyframe_ = T_odom_camera_ = last_motion_ = Eigen::Isometry3d::Identity();
+  keyframe_covariance_ = covariance_ = Matrix6::Zero();
+  last_dt_ = last_stamp_ = 0;
+  consecutive_lost_ = 0;
+}
+
+void OdometryTracker::setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics) {
+  icp_.setReference(cloud, intrinsics);
+  T_odom_keyframe_ = T_odom_camera_;
+  keyframe_covariance_ = covariance_;
+}
+
+OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_keyframe) const {
+  Result out;
+  out.T_odom_camera = T_odom_camera_;
+  out.status = status;
+  out.new_keyframe = new_keyframe;
+  out.consecutive_lost = consecutive_lost_;
+  // Left perturbation exp(xi^) T: t_true = t + v + omega x t, so (dt, r) = [I -[t]x; 0 I] xi.
+  Matrix6 M = Matrix6::Identity();
+  M.topRightCorner<3, 3>() = -pose_math::skew(T_odom_camera_.translation());
+  out.covariance = M * covariance_ * M.transpose();
+  return out;
+}
+
+OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
+                                               const CameraIntrinsics& intrinsics, double stamp) {
+  std::string problem;
+  if (organizedCloudDecimation(intrinsics, static_cast<int>(cloud.width),
+                               static_cast<int>(cloud.height), &problem) == 0)
+    throw std::invalid_argument("OdometryTracker::track: " + problem);
+  const auto usable = [&] { return icp_.usablePoints(cloud) >= params_.icp.min_correspondences; };
+
+  if (!initialized_) {
+    if (!usable()) {
+      ++consecutive_lost_;
+      Result out = output(TrackingStatus::kLost, false);
+      out.icp.message = "first frame has too few usable points";
+      return out;
+    }
+    T_odom_camera_ = Eigen::Isometry3d::Identity();
+    covariance_ = Matrix6::Zero();
+    setKeyframe(cloud, intrinsics);
+    initialized_ = true;
+    last_motion_ = Eigen::Isometry3d::Identity();
+    last_dt_ = 0;
+    last_stamp_ = stamp;
+    consecutive_lost_ = 0;
+    Result out = output(TrackingStatus::kOk, true);
+    out.icp.status = TrackingStatus::kOk;
+    return out;
+  }
+
+  // Constant-velocity prior: the last inter-frame motion scaled to this time step.
+  const double dt = stamp - last_stamp_;
+  Eigen::Isometry3d prediction = T_odom_camera_;
+  if (params_.constant_velocity) {
+    const double k = (last_dt_ > 0 && dt > 0) ? std::clamp(dt / last_dt_, 0.0, 3.0) : 1.0;
+    prediction =
+        pose_math::orthonormalized(T_odom_camera_ * pose_math::scaleMotion(last_motion_, k));
+  }
+  const Eigen::Isometry3d T_keyframe_odom = T_odom_keyframe_.inverse();
+  PointToPlaneIcp::Result icp = icp_.align(cloud, T_keyframe_odom * prediction);
+
+  const Eigen::Isometry3d previous = T_odom_camera_;
+  bool new_keyframe = false;
+  if (icp.status == TrackingStatus::kLost) {
+    // Keep the last pose (no velocity: the motion is unknown) and grow the uncertainty.
+    ++consecutive_lost_;
+    last_motion_ = Eigen::Isometry3d::Identity();
+    covariance_ += Matrix6::Identity() * params_.icp.degenerate_variance;
+    if (consecutive_lost_ >= params_.lost_frames_before_new_keyframe && usable()) {
+      setKeyframe(cloud, intrinsics);
+      new_keyframe = true;
+    }
+  } else {
+    consecutive_lost_ = 0;
+    T_odom_camera_ = pose_math::orthonormalized(T_odom_keyframe_ * icp.T_reference_current);
+    // First-order composition: T_odom_cur = exp(a) T_odom_kf exp(b) T_kf_cur
+    //                                     = exp(a + Ad(T_odom_kf) b) T_odom_cur.
+    const Matrix6 ad = pose_math::adjoint(T_odom_keyframe_);
+    covariance_ = keyframe_covariance_ + ad * icp.covariance * ad.transpose();
+    last_motion_ = pose_math::orthonormalized(previous.inverse() * T_odom_camera_);
+    const Eigen::Isometry3d& from_keyframe = icp.T_reference_current;
+    if (from_keyframe.translation().norm() > params_.keyframe_translation ||
+        pose_math::rotationAngle(from_keyframe) > params_.keyframe_rotation ||
+        icp.inlier_fraction < params_.keyframe_min_overlap) {
+      setKeyframe(cloud, intrinsics);
+      new_keyframe = true;
+    }
+  }
+  last_dt_ = dt > 0 ? dt : 0;
+  last_stamp_ = stamp;
+  Result out = output(icp.status, new_keyframe);
+  out.icp = std::move(icp);
+  return out;
+}
+
+}  // namespace quadric_slam

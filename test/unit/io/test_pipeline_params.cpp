@@ -1,0 +1,77 @@
+// The parameter key tables read config/*.yaml exactly as the nodelets read their private
+// parameters: every key of the shipped files is known, values arrive, bad values are refused.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+
+#include "quadric_slam/io/pipeline_params.h"
+
+namespace qs = quadric_slam;
+
+namespace {
+
+const std::string kConfigDir = std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/";
+
+}  // namespace
+
+TEST(PipelineParams, NormalEstimationYamlKeysAreAllRead) {
+  const YAML::Node file = YAML::LoadFile(kConfigDir + "normal_estimation.yaml");
+  qs::BackProjectionParams back_projection;
+  qs::NormalEstimator::Params normals;
+  qs::ParamLog log;
+  qs::readNormalEstimationParams(qs::YamlParamReader(file), back_projection, normals, log);
+  int queue_size = 5;  // a nodelet-level key, read beside the table
+  qs::readParam(qs::YamlParamReader(file), "queue_size", queue_size, log);
+  for (const auto& entry : file) {
+    const std::string key = entry.first.as<std::string>();
+    EXPECT_NE(log.str().find("\n  " + key + ": "), std::string::npos)
+        << "config/normal_estimation.yaml key '" << key << "' is read by nobody";
+  }
+  EXPECT_EQ(normals.method, file["normal_method"].as<std::string>());
+  EXPECT_EQ(back_projection.decimation, file["decimation"].as<int>());
+}
+
+TEST(PipelineParams, ValuesOverrideDefaultsAndBadValuesAreRefused) {
+  qs::BackProjectionParams back_projection;
+  qs::NormalEstimator::Params normals;
+  qs::ParamLog log;
+  qs::readNormalEstimationParams(
+      qs::YamlParamReader(YAML::Load("{decimation: 2, normal_method: covariance_matrix}")),
+      back_projection, normals, log);
+  EXPECT_EQ(back_projection.decimation, 2);
+  EXPECT_EQ(normals.method, "covariance_matrix");
+  EXPECT_DOUBLE_EQ(back_projection.max_range, qs::BackProjectionParams().max_range);
+
+  EXPECT_THROW(qs::readNormalEstimationParams(qs::YamlParamReader(YAML::Load("{decimation: 0}")),
+                                              back_projection, normals, log),
+               std::invalid_argument);
+  EXPECT_THROW(
+      qs::readNormalEstimationParams(qs::YamlParamReader(YAML::Load("{decimation: [1, 2]}")),
+                                     back_projection, normals, log),
+      std::invalid_argument);
+  EXPECT_THROW(qs::YamlParamReader::fromFile("/nonexistent.yaml"), std::runtime_error);
+}
+
+TEST(PipelineParams, OdometryYamlKeysAreAllRead) {
+  const YAML::Node file = YAML::LoadFile(kConfigDir + "odometry.yaml");
+  const qs::YamlParamReader reader(file);
+  qs::OdometryTracker::Params params;
+  qs::ParamLog log;
+  qs::readOdometryParams(reader, params, log);
+  // Nodelet-level keys, read beside the table.
+  std::string frame;
+  bool publish_tf = true;
+  int queue_size = 5;
+  qs::readParam(reader, "odom_frame", frame, log);
+  qs::readParam(reader, "camera_frame", frame, log);
+  qs::readParam(reader, "publish_tf", publish_tf, log);
+  qs::readParam(reader, "queue_size", queue_size, log);
+  for (const auto& entry : file) {
+    const std::string key = entry.first.as<std::string>();
+    EXPECT_NE(log.str().find("\n  " + key + ": "), std::string::npos)
+        << "config/odometry.yaml key '" << key << "' is read by nobody";
+  }
+  EXPECT_EQ(params.icp.pyramid_levels, file["pyramid_levels"].as<int>());
+  EXPECT_DOUBLE_EQ(params.keyframe_translation, file["keyframe_translation"].as<double>());
+}

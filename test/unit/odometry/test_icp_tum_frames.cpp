@@ -1,0 +1,115 @@
+// Point-to-plane ICP on real Kinect frames of the TUM RGB-D benchmark (fr1_xyz), checked against
+// the benchmark's motion-capture ground truth. Skips when ../shared/data is absent.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/odometry/point_to_plane_icp.h"
+
+namespace quadric_slam {
+namespace {
+
+const std::string kData = QUADRIC_SLAM_SHARED_DATA_DIR;
+
+// Ground-truth pose (T_world_camera, colour optical frame) at time t, interpolated linearly in
+// position and by slerp in orientation between the two bracketing motion-capture samples.
+bool groundTruthAt(const std::string& path, double t, Eigen::Isometry3d* pose) {
+  std::ifstream in(path);
+  std::string line;
+  double t0 = 0;
+  Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q0 = Eigen::Quaterniond::Identity();
+  bool have_previous = false;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#')
+      continue;
+    std::istringstream fields(line);
+    double stamp, tx, ty, tz, qx, qy, qz, qw;
+    if (!(fields >> stamp >> tx >> ty >> tz >> qx >> qy >> qz >> qw))
+      continue;
+    const Eigen::Vector3d p(tx, ty, tz);
+    const Eigen::Quaterniond q(qw, qx, qy, qz);
+    if (have_previous && t0 <= t && t <= stamp) {
+      const double s = (t - t0) / (stamp - t0);
+      pose->setIdentity();
+      pose->linear() = q0.normalized().slerp(s, q.normalized()).toRotationMatrix();
+      pose->translation() = (1 - s) * p0 + s * p;
+      return true;
+    }
+    t0 = stamp;
+    p0 = p;
+    q0 = q;
+    have_previous = true;
+  }
+  return false;
+}
+
+pcl::PointCloud<pcl::PointNormal>::Ptr loadDepth(const std::string& path,
+                                                 const CameraIntrinsics& k) {
+  const cv::Mat depth = cv::imread(path, cv::IMREAD_UNCHANGED);
+  if (depth.empty() || depth.type() != CV_16UC1)
+    return nullptr;
+  DepthImageView<std::uint16_t> view;
+  view.data = depth.data;
+  view.width = depth.cols;
+  view.height = depth.rows;
+  view.row_step_bytes = depth.step;
+  view.metres_per_unit = 1.0 / 5000.0;  // TUM PNG depth
+  const pcl::PointCloud<pcl::PointXYZ> xyz = backProject(view, k, BackProjectionParams());
+  return pcl::make_shared<pcl::PointCloud<pcl::PointNormal>>(
+      NormalEstimator(NormalEstimator::Params()).compute(xyz));
+}
+
+// Two fr1_xyz depth frames 0.1 s apart (2.6 cm and 2 degrees of real hand-held motion). The
+// estimate must agree with motion capture to 5 mm and 1 degree. Why not tighter: the benchmark's
+// own RGB-D SLAM reaches 1.3 cm ATE on this sequence; mocap positions are good to about 1 mm, but
+// the relative rotation read from the ground truth changes by 0.25 degrees per 10 ms sample around
+// these stamps (1.5-2.5 degrees for bracketing samples within +-20 ms), so a few milliseconds of
+// depth/mocap clock offset move the reference by several tenths of a degree. (The benchmark's
+// RGB-D SLAM trajectory gives 1.61 degrees for this pair, ICP 1.56, the interpolated truth 2.05.)
+TEST(IcpOnTumFrames, Fr1XyzMatchesMotionCapture) {
+  const std::string dir = kData + "/tum_frames/fr1_xyz/";
+  const std::string gt = kData + "/tum_groundtruth/rgbd_dataset_freiburg1_xyz-groundtruth.txt";
+  const double t_a = 1305031102.160407, t_b = 1305031102.262886;
+  CameraIntrinsics k;  // Freiburg1 depth intrinsics (README of the data)
+  k.fx = 517.3;
+  k.fy = 516.5;
+  k.cx = 318.6;
+  k.cy = 255.3;
+  k.width = 640;
+  k.height = 480;
+  auto a = loadDepth(dir + "1305031102.160407.png", k);
+  auto b = loadDepth(dir + "1305031102.262886.png", k);
+  Eigen::Isometry3d T_world_a, T_world_b;
+  if (!a || !b || !groundTruthAt(gt, t_a, &T_world_a) || !groundTruthAt(gt, t_b, &T_world_b)) {
+    GTEST_SKIP() << "TUM fr1_xyz frames or ground truth not found under " << kData;
+  }
+  const Eigen::Isometry3d T_a_b = T_world_a.inverse() * T_world_b;
+  ASSERT_GT(T_a_b.translation().norm(), 0.02);  // the frames really are apart
+
+  PointToPlaneIcp icp(PointToPlaneIcp::Params{});
+  icp.setReference(*a, k);
+  const PointToPlaneIcp::Result r = icp.align(*b, Eigen::Isometry3d::Identity());
+  ASSERT_EQ(r.status, TrackingStatus::kOk) << r.message;
+  const Eigen::Isometry3d error = T_a_b.inverse() * r.T_reference_current;
+  EXPECT_LT(error.translation().norm(), 5e-3)
+      << "estimate " << r.T_reference_current.translation().transpose() << " truth "
+      << T_a_b.translation().transpose();
+  EXPECT_LT(pose_math::rotationAngle(error), 1.0 * M_PI / 180)
+      << "estimate " << Eigen::AngleAxisd(r.T_reference_current.linear()).angle() * 180 / M_PI
+      << " deg about " << Eigen::AngleAxisd(r.T_reference_current.linear()).axis().transpose()
+      << ", truth " << Eigen::AngleAxisd(T_a_b.linear()).angle() * 180 / M_PI << " deg about "
+      << Eigen::AngleAxisd(T_a_b.linear()).axis().transpose() << "; translation error "
+      << error.translation().norm();
+  EXPECT_GT(r.inlier_fraction, 0.7);
+}
+
+}  // namespace
+}  // namespace quadric_slam
