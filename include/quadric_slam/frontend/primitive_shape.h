@@ -1,0 +1,80 @@
+// A human-readable primitive (plane, sphere, cylinder, cone) in some frame, its conversion to the
+// quadric pose/scale conventions of msg/QuadricSurface.msg, its geometric distance, and the class's
+// minimal perturbation (Table II subset of (rho, phi, s)).
+//
+// Interim: the geometry core (geometry/quadric.h, geometry/shapes.h) replaces the pose/scale
+// conversion once merged; this struct keeps the segmenter independent of it.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "quadric_slam/geometry/quadric_class.h"
+
+namespace quadric_slam {
+
+struct PrimitiveShape {
+  QuadricClass quadric_class = QuadricClass::kPlane;
+  // plane: a point on the plane; sphere: centre; cylinder: a point on the axis; cone: apex (m).
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  // plane: unit normal; cylinder, cone: unit axis (cone: from the apex into the opening); sphere:
+  // unused.
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();
+  // sphere, cylinder: radius (m); cone: half angle (rad); plane: unused.
+  double size = 0.0;
+
+  static PrimitiveShape plane(const Eigen::Vector3d& normal, double offset);
+  static PrimitiveShape sphere(const Eigen::Vector3d& centre, double radius);
+  static PrimitiveShape cylinder(const Eigen::Vector3d& point, const Eigen::Vector3d& axis,
+                                 double radius);
+  static PrimitiveShape cone(const Eigen::Vector3d& apex, const Eigen::Vector3d& axis,
+                             double half_angle);
+
+  // Plane offset n.p (points p with n.p = offset).
+  double planeOffset() const { return direction.dot(point); }
+
+  // The `shape` vector of msg/QuadricSurface.msg: plane [n, offset], sphere [c, r], cylinder
+  // [p, d, r], cone [apex, d, half_angle].
+  std::vector<double> shapeVector() const;
+  // The `shape` block of the map schema (io/map_yaml.h keys): plane normal, offset; sphere
+  // center, radius; cylinder point, axis, radius; cone apex, axis, half_angle.
+  std::map<std::string, std::vector<double>> schemaShape() const;
+
+  // Pose of the canonical quadric frame (plane normal = x; cylinder/cone axis = z; cone apex =
+  // origin; plane origin = the point, sphere origin = centre, cylinder origin = the axis point)
+  // and the diagonal of S (1/m), as msg/QuadricSurface.msg fixes them.
+  Eigen::Isometry3d poseInFrame() const;
+  Eigen::Vector3d scale() const;
+  // Inverse of (poseInFrame, scale).
+  static PrimitiveShape fromPose(QuadricClass quadric_class,
+                                 const Eigen::Isometry3d& T_frame_quadric,
+                                 const Eigen::Vector3d& scale);
+
+  // Signed geometric distance (m) of a point (same frame) to the surface: plane n.p - offset,
+  // sphere |p - c| - r, cylinder (distance to axis) - r, cone rho cos(a) - z sin(a) in the cone
+  // frame (exact near the nappe).
+  double distance(const Eigen::Vector3d& p) const;
+  // Unit surface normal at the foot of p (sign not meaningful).
+  Eigen::Vector3d normalAt(const Eigen::Vector3d& p) const;
+
+  // The same surface expressed in another frame: T_b_a maps points of this shape's frame a to b.
+  PrimitiveShape transformed(const Eigen::Isometry3d& T_b_a) const;
+};
+
+// The minimal parameters of a class (Table II) as indices into the 7-vector
+// (rho1, rho2, rho3, phi1, phi2, phi3, s) of a right perturbation in the quadric frame:
+// T' = T_frame_quadric * (Rot(phi), rho), S' = S + s on the radial scale entries.
+// plane (rho1, phi2, phi3); sphere (rho1..3, s); cylinder (rho1, rho2, phi1, phi2, s);
+// cone (rho1..3, phi1, phi2, s). The scale s perturbs alpha (sphere: 1/r; cylinder: 1/r on x and
+// y; cone: 1/tan(half_angle) on x and y).
+const std::vector<int>& minimalIndices(QuadricClass quadric_class);
+
+// pi [+] delta (eqs. 10-17, right-perturbation form, first order in phi): delta has
+// minimalDimension(class) entries ordered as minimalIndices().
+PrimitiveShape perturb(const PrimitiveShape& shape, const Eigen::VectorXd& delta);
+
+}  // namespace quadric_slam

@@ -1,0 +1,136 @@
+// Quadric segmentation of one depth frame: organized cloud with normals -> planes, spheres,
+// cylinders and cones (the paper's front-end, Section IV), each with its least-squares fit,
+// covariance, support and image extent, plus a label image.
+//
+// Pipeline (all in the camera frame):
+//  1. planes by region growing over the image grid (plane_region_grower.h), flatness-checked;
+//  2. CGAL Efficient RANSAC (Schnabel et al. 2007) with sphere, cylinder, cone (and plane, to
+//     absorb small planar patches) on a sub-sample of each image-grid connected component of
+//     the remaining points;
+//  3. for each CGAL shape, biggest first: range and degeneracy filters (huge-radius cylinders,
+//     near-flat cones and big spheres are tested against a plane; thin cones against a
+//     cylinder), least-squares refinement, re-assignment of all free full-resolution pixels
+//     near the surface with agreeing normals, the largest image-grid connected component,
+//     minimum support, refinement again (shape_refiner.h).
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "quadric_slam/frontend/observation.h"  // ImageRoi
+#include "quadric_slam/frontend/plane_region_grower.h"
+#include "quadric_slam/frontend/primitive_shape.h"
+#include "quadric_slam/frontend/shape_refiner.h"
+
+namespace quadric_slam {
+
+// One segmented primitive, in the frame of the input cloud (the camera frame).
+struct QuadricDetection {
+  PrimitiveShape shape;
+  // Covariance of the fit in the class's minimal coordinates (primitive_shape.h minimalIndices:
+  // plane (rho1, phi2, phi3); sphere (rho1..3, alpha); cylinder (rho1, rho2, phi1, phi2, alpha);
+  // cone (rho1..3, phi1, phi2, alpha); right perturbation in the quadric frame of
+  // shape.poseInFrame(), alpha the radial entry of S): sigma^2 (J^T J)^-1 of the least squares.
+  Eigen::MatrixXd covariance;
+  int num_points = 0;    // supporting points (cloud grid)
+  double fit_rms = 0.0;  // RMS geometric distance of the supporting points (m)
+  std::uint16_t label = 0;
+  ImageRoi roi;  // bounding box of the supporting pixels in the cloud's grid
+  // Axis-aligned box of the supporting points in the quadric frame of shape.poseInFrame() (m).
+  Eigen::Vector3d extent_min = Eigen::Vector3d::Zero(), extent_max = Eigen::Vector3d::Zero();
+};
+
+// Wall-clock time of the segmenter's stages for one frame (ms), for benchmarks and diagnostics.
+struct SegmentationTimings {
+  double planes_ms = 0.0;     // region growing, merging and plane refinement
+  double ransac_ms = 0.0;     // sub-sampling and CGAL Efficient RANSAC
+  double verify_ms = 0.0;     // filters, refinement and re-assignment of curved candidates
+  double upsample_ms = 0.0;   // decimation and full-resolution labelling (decimation > 1)
+  int ransac_points = 0;      // points given to CGAL
+  int ransac_candidates = 0;  // shapes CGAL returned
+};
+
+struct Segmentation {
+  SegmentationTimings timings;
+  std::vector<QuadricDetection> detections;
+  // CV_16UC1, the cloud's size: 0 = unassigned, else the label of the detection owning the point.
+  cv::Mat labels;
+};
+
+class QuadricSegmenter {
+ public:
+  struct Params {
+    // Points outside [min_range, max_range] of depth (z, m) are ignored. 0 < min < max.
+    double min_range = 0.3;
+    double max_range = 4.5;
+    // The segmentation runs on every decimation-th pixel in u and v (point counts and strides
+    // below are scaled accordingly) and the labels are then assigned at full resolution: each
+    // pixel takes a neighbouring sample's label when it fits that surface. [1, 8]. Default 2.
+    int decimation = 2;
+    // Planes (region growing); its min_points is in points of the cloud grid.
+    PlaneRegionGrower::Params planes;
+    // Curved shapes.
+    bool detect_spheres = true, detect_cylinders = true, detect_cones = true;
+    // Every cgal_stride-th free pixel in u and v goes to CGAL, [1, 16]. Default 3.
+    int cgal_stride = 3;
+    // A larger stride is used in a component that would give CGAL more points than this, >= 100.
+    int cgal_max_points = 2000;
+    // CGAL Efficient RANSAC: probability of missing the largest shape, (0, 1); minimum support
+    // (sub-sampled points), >= 4; distance epsilon (m), > 0; cluster epsilon (m), > 0; normal
+    // threshold (cosine), (0, 1).
+    double cgal_probability = 0.2;
+    int cgal_min_points = 40;
+    double cgal_epsilon = 0.008;
+    double cgal_cluster_epsilon = 0.03;
+    double cgal_normal_threshold = 0.85;
+    // CGAL runs once per connected component of the free points; its minimum support there is
+    // max(cgal_min_points, cgal_min_fraction * sub-sampled component size), [0, 1).
+    double cgal_min_fraction = 0.08;
+    // Assignment of full-resolution pixels to a curved shape: distance threshold
+    // max(min_distance, distance_factor * z^2) of the planes, and this normal angle (rad),
+    // (0, pi/2).
+    double curved_max_normal_angle = 0.6;
+    // Smallest curved segment (points of the cloud grid), >= 4.
+    int min_curved_points = 250;
+    // Plausible sizes (m, rad): sphere radius, cylinder radius, cone half angle.
+    double min_sphere_radius = 0.03, max_sphere_radius = 0.6;
+    double min_cylinder_radius = 0.01, max_cylinder_radius = 0.5;
+    double min_cone_half_angle = 0.05, max_cone_half_angle = 1.2;
+    // Degeneracy: a curved fit whose RMS is not clearly better than a plane's (plane RMS <
+    // plane_rms_ratio * curved RMS) is a plane; a cone or cylinder whose RMS is not clearly
+    // better than that of a simpler class (cone -> cylinder -> sphere; RMS of the simpler <
+    // cylinder_rms_ratio * its own) becomes the simpler class. Ratios >= 1.
+    double plane_rms_ratio = 1.5;
+    double cylinder_rms_ratio = 1.15;
+    // Largest fit RMS of a curved segment, relative to its distance threshold at the median
+    // depth, (0, 10].
+    double max_rms_factor = 0.6;
+    // Least-squares refinement.
+    ShapeRefiner::Params refiner;
+    // Seed of CGAL's random sampling (fixed: the same frame gives the same result).
+    unsigned int random_seed = 1;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  explicit QuadricSegmenter(const Params& params);
+
+  // cloud: organized, normals NaN where unknown. Throws std::invalid_argument when unorganized.
+  Segmentation segment(const pcl::PointCloud<pcl::PointNormal>& cloud) const;
+
+  const Params& params() const { return params_; }
+
+ private:
+  Params params_;
+};
+
+// A colour per label (0 black) as in the paper's Fig. 2: CV_8UC3 in RGB order.
+cv::Mat colouriseLabels(const cv::Mat& labels);
+
+}  // namespace quadric_slam

@@ -1,0 +1,52 @@
+// Scoring a segmentation against per-pixel ground-truth surface ids (the synthetic generator's
+// labels/<stamp>.png with the classes of quadrics_gt.yaml), accumulated over frames.
+#pragma once
+
+#include <map>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "quadric_slam/frontend/quadric_segmenter.h"
+
+namespace quadric_slam {
+
+class SegmentationScore {
+ public:
+  // truth_classes: surface id -> class name of the map schema (plane, sphere, cylinder, cone,
+  // ellipsoid, ...); surfaces of other classes than the four primitives are not scored.
+  // min_pixels: a surface is scored in a frame when it has at least this many valid pixels.
+  SegmentationScore(std::map<int, std::string> truth_classes, int min_pixels);
+
+  // truth: CV_16UC1 surface ids (0 = none), the size of segmentation.labels; valid: CV_8UC1,
+  // non-zero where the depth is valid (labels of pixels without depth are not counted). A scored
+  // surface is detected when a detection of its class has >= 50% of its pixels on the surface and
+  // covers >= 30% of the surface's pixels. A detection is spurious when the majority of its pixels
+  // lies on no surface or on a surface of another class.
+  void addFrame(const Segmentation& segmentation, const cv::Mat& truth, const cv::Mat& valid);
+
+  struct Surface {
+    std::string quadric_class;
+    int frames_scored = 0, frames_detected = 0;
+    double rate() const { return frames_scored ? double(frames_detected) / frames_scored : 0.0; }
+  };
+  const std::map<int, Surface>& surfaces() const { return surfaces_; }
+  int frames() const { return frames_; }
+  int spurious() const { return spurious_; }
+  double spuriousPerFrame() const { return frames_ ? double(spurious_) / frames_ : 0.0; }
+  // The spurious detections whose majority lies on a surface of a class the segmenter has no
+  // model for (e.g. an ellipsoid taken as a sphere); included in spurious().
+  int spuriousOnUnmodelled() const { return spurious_unmodelled_; }
+  double spuriousPerFrameOnModelled() const {
+    return frames_ ? double(spurious_ - spurious_unmodelled_) / frames_ : 0.0;
+  }
+  std::string report() const;
+
+ private:
+  std::map<int, std::string> truth_classes_;
+  int min_pixels_;
+  std::map<int, Surface> surfaces_;
+  int frames_ = 0, spurious_ = 0, spurious_unmodelled_ = 0;
+  std::map<std::string, int> spurious_kinds_;  // "<detected class> on <surface class>" -> count
+};
+
+}  // namespace quadric_slam

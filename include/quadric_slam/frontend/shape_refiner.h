@@ -1,0 +1,58 @@
+// Least-squares refinement of a primitive on its supporting points: Levenberg-Marquardt on the
+// geometric distances in the class's minimal coordinates (Table II, see primitive_shape.h), and the
+// covariance of the fit in those coordinates.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "quadric_slam/frontend/primitive_shape.h"
+
+namespace quadric_slam {
+
+class ShapeRefiner {
+ public:
+  struct Params {
+    // Levenberg-Marquardt iterations at most, [1, 100]. Default 10.
+    int max_iterations = 10;
+    // Stop when the step's relative cost decrease is below this, (0, 1). Default 1e-6.
+    double relative_tolerance = 1e-6;
+    // Points used at most (an even sub-sample beyond this; the covariance is scaled back to all
+    // points), [10, 1e7]. Default 1000.
+    int max_points = 1000;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  struct Result {
+    PrimitiveShape shape;
+    // Covariance in the minimal coordinates of primitive_shape.h (minimalIndices order):
+    // sigma^2 (J^T J)^-1 with sigma^2 the residual variance, J the Jacobian of the distances over
+    // all points (m, rad, 1/m).
+    Eigen::MatrixXd covariance;
+    double rms = 0.0;  // RMS geometric distance of the points to the refined surface (m)
+    bool ok = false;   // false when too few points or a degenerate normal matrix
+  };
+
+  ShapeRefiner() : ShapeRefiner(Params()) {}
+  explicit ShapeRefiner(const Params& params);
+
+  Result refine(const PrimitiveShape& initial, const std::vector<Eigen::Vector3d>& points) const;
+  // The covariance and RMS of shape on points without iterating (for an exact least-squares
+  // solution such as the PCA plane).
+  Result evaluate(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) const;
+
+ private:
+  Params params_;
+};
+
+// Total least-squares plane through points (PCA); normal oriented towards the origin (the camera)
+// and point = centroid. Requires >= 3 points.
+PrimitiveShape fitPlane(const std::vector<Eigen::Vector3d>& points);
+// Algebraic sphere fit (|p|^2 + a.p + b = 0 in least squares); requires >= 4 points.
+PrimitiveShape fitSphereAlgebraic(const std::vector<Eigen::Vector3d>& points);
+// RMS of the distances of points to shape (m).
+double rmsDistance(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points);
+
+}  // namespace quadric_slam

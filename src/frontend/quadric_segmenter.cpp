@@ -1,0 +1,633 @@
+#include "quadric_slam/frontend/quadric_segmenter.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "quadric_slam/frontend/cgal_shape_detector.h"
+
+namespace quadric_slam {
+
+namespace {
+
+void require(bool ok, const std::string& message) {
+  if (!ok)
+    throw std::invalid_argument("QuadricSegmenter: " + message);
+}
+
+std::string str(double value) {
+  return std::to_string(value);
+}
+
+double msSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+Eigen::Vector3d pointOf(const pcl::PointNormal& p) {
+  return Eigen::Vector3d(p.x, p.y, p.z);
+}
+Eigen::Vector3d normalOf(const pcl::PointNormal& p) {
+  return Eigen::Vector3d(p.normal_x, p.normal_y, p.normal_z);
+}
+
+std::vector<Eigen::Vector3d> pointsOf(const pcl::PointCloud<pcl::PointNormal>& cloud,
+                                      const std::vector<int>& indices) {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(indices.size());
+  for (int i : indices)
+    points.push_back(pointOf(cloud.points[i]));
+  return points;
+}
+
+double medianDepth(const pcl::PointCloud<pcl::PointNormal>& cloud, const std::vector<int>& idx) {
+  std::vector<float> z;
+  z.reserve(idx.size());
+  for (int i : idx)
+    z.push_back(cloud.points[i].z);
+  std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+  return z[z.size() / 2];
+}
+
+// Everything the segmenter shares between its steps for one frame.
+struct Frame {
+  const pcl::PointCloud<pcl::PointNormal>& cloud;
+  int width, height;
+  std::vector<std::uint8_t> valid, used;
+};
+
+// Pixels of the frame's free points inside roi that lie within the distance threshold of shape
+// and whose normal agrees; the largest 4-connected component of them.
+std::vector<int> assignLargestComponent(const Frame& frame, const PrimitiveShape& shape,
+                                        const ImageRoi& roi, const QuadricSegmenter::Params& p) {
+  const double cos_angle = std::cos(p.curved_max_normal_angle);
+  const int x0 = roi.x_offset, y0 = roi.y_offset, w = roi.width, h = roi.height;
+  std::vector<std::uint8_t> candidate(static_cast<std::size_t>(w) * h, 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int i = (y + y0) * frame.width + (x + x0);
+      if (!frame.valid[i] || frame.used[i])
+        continue;
+      const pcl::PointNormal& q = frame.cloud.points[i];
+      const Eigen::Vector3d point = pointOf(q);
+      if (std::abs(shape.distance(point)) >
+          depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance))
+        continue;
+      if (std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle)
+        continue;
+      candidate[y * w + x] = 1;
+    }
+  }
+  std::vector<int> best, component, stack;
+  std::vector<std::uint8_t> seen(candidate.size(), 0);
+  for (int start = 0; start < static_cast<int>(candidate.size()); ++start) {
+    if (!candidate[start] || seen[start])
+      continue;
+    component.clear();
+    stack.assign(1, start);
+    seen[start] = 1;
+    while (!stack.empty()) {
+      const int k = stack.back();
+      stack.pop_back();
+      const int x = k % w, y = k / w;
+      component.push_back((y + y0) * frame.width + (x + x0));
+      const float zk = frame.cloud.points[(y + y0) * frame.width + (x + x0)].z;
+      const int neighbours[4] = {x > 0 ? k - 1 : -1, x + 1 < w ? k + 1 : -1, y > 0 ? k - w : -1,
+                                 y + 1 < h ? k + w : -1};
+      for (int m : neighbours) {
+        if (m < 0 || !candidate[m] || seen[m])
+          continue;
+        const float zm = frame.cloud.points[(m / w + y0) * frame.width + (m % w + x0)].z;
+        if (std::abs(zm - zk) > p.planes.max_depth_jump_factor * zk)
+          continue;
+        seen[m] = 1;
+        stack.push_back(m);
+      }
+    }
+    if (component.size() > best.size())
+      best.swap(component);
+  }
+  return best;
+}
+
+// 4-connected components of the valid, unused points (depth jumps break connectivity).
+std::vector<std::vector<int>> freeComponents(const Frame& frame,
+                                             const QuadricSegmenter::Params& p) {
+  std::vector<std::vector<int>> components;
+  std::vector<std::uint8_t> seen(frame.valid.size(), 0);
+  std::vector<int> stack;
+  const auto& points = frame.cloud.points;
+  for (int start = 0; start < static_cast<int>(seen.size()); ++start) {
+    if (seen[start] || !frame.valid[start] || frame.used[start])
+      continue;
+    std::vector<int> component;
+    stack.assign(1, start);
+    seen[start] = 1;
+    while (!stack.empty()) {
+      const int k = stack.back();
+      stack.pop_back();
+      component.push_back(k);
+      const int u = k % frame.width, v = k / frame.width;
+      const int neighbours[4] = {u > 0 ? k - 1 : -1, u + 1 < frame.width ? k + 1 : -1,
+                                 v > 0 ? k - frame.width : -1,
+                                 v + 1 < frame.height ? k + frame.width : -1};
+      for (int m : neighbours) {
+        if (m < 0 || seen[m] || !frame.valid[m] || frame.used[m])
+          continue;
+        if (std::abs(points[m].z - points[k].z) > p.planes.max_depth_jump_factor * points[k].z)
+          continue;
+        seen[m] = 1;
+        stack.push_back(m);
+      }
+    }
+    components.push_back(std::move(component));
+  }
+  return components;
+}
+
+ImageRoi roiOf(const std::vector<int>& indices, int width) {
+  int x_min = std::numeric_limits<int>::max(), y_min = x_min, x_max = -1, y_max = -1;
+  for (int i : indices) {
+    const int x = i % width, y = i / width;
+    x_min = std::min(x_min, x);
+    x_max = std::max(x_max, x);
+    y_min = std::min(y_min, y);
+    y_max = std::max(y_max, y);
+  }
+  ImageRoi roi;
+  if (x_max < 0)
+    return roi;
+  roi.x_offset = x_min;
+  roi.y_offset = y_min;
+  roi.width = x_max - x_min + 1;
+  roi.height = y_max - y_min + 1;
+  return roi;
+}
+
+ImageRoi grown(const ImageRoi& roi, int margin, int width, int height) {
+  ImageRoi g;
+  g.x_offset = std::max(0, roi.x_offset - margin);
+  g.y_offset = std::max(0, roi.y_offset - margin);
+  g.width = std::min(width, roi.x_offset + roi.width + margin) - g.x_offset;
+  g.height = std::min(height, roi.y_offset + roi.height + margin) - g.y_offset;
+  return g;
+}
+
+// Cylinder through the points around the cone's axis (the degenerate thin cone).
+PrimitiveShape cylinderFromCone(const PrimitiveShape& cone,
+                                const std::vector<Eigen::Vector3d>& points) {
+  const Eigen::Vector3d d = cone.direction;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& q : points)
+    mean += q;
+  mean /= static_cast<double>(points.size());
+  const Eigen::Vector3d on_axis = cone.point + d.dot(mean - cone.point) * d;
+  double radius = 0;
+  for (const auto& q : points) {
+    const Eigen::Vector3d v = q - on_axis;
+    radius += (v - d.dot(v) * d).norm();
+  }
+  return PrimitiveShape::cylinder(on_axis, d, radius / points.size());
+}
+
+bool plausible(const PrimitiveShape& s, const QuadricSegmenter::Params& p) {
+  if (!s.point.allFinite() || !s.direction.allFinite() || !std::isfinite(s.size))
+    return false;
+  switch (s.quadric_class) {
+    case QuadricClass::kSphere:
+      return s.size >= p.min_sphere_radius && s.size <= p.max_sphere_radius;
+    case QuadricClass::kCylinder:
+      return s.size >= p.min_cylinder_radius && s.size <= p.max_cylinder_radius;
+    case QuadricClass::kCone:
+      return s.size >= p.min_cone_half_angle && s.size <= p.max_cone_half_angle;
+    default:
+      return true;
+  }
+}
+
+// Moves a curved shape's origin to the foot of the supporting points' centroid on its axis (the
+// cylinder's point is free along the axis) so that extents are centred.
+void centreOnSupport(PrimitiveShape& s, const std::vector<Eigen::Vector3d>& points) {
+  if (points.empty())
+    return;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& q : points)
+    mean += q;
+  mean /= static_cast<double>(points.size());
+  if (s.quadric_class == QuadricClass::kCylinder) {
+    s.point += s.direction.dot(mean - s.point) * s.direction;
+  } else if (s.quadric_class == QuadricClass::kPlane) {
+    s.point = mean - s.direction.dot(mean - s.point) * s.direction;
+  }
+}
+
+}  // namespace
+
+void QuadricSegmenter::Params::validate() const {
+  require(min_range > 0 && min_range < max_range,
+          "min_range and max_range must satisfy 0 < min_range < max_range (m), got " +
+              str(min_range) + ", " + str(max_range));
+  require(decimation >= 1 && decimation <= 8,
+          "decimation must be in [1, 8], got " + std::to_string(decimation));
+  planes.validate();
+  refiner.validate();
+  require(cgal_stride >= 1 && cgal_stride <= 16,
+          "cgal_stride must be in [1, 16], got " + std::to_string(cgal_stride));
+  require(cgal_probability > 0 && cgal_probability < 1,
+          "cgal_probability must be in (0, 1), got " + str(cgal_probability));
+  require(cgal_min_points >= 4,
+          "cgal_min_points must be >= 4, got " + std::to_string(cgal_min_points));
+  require(cgal_epsilon > 0, "cgal_epsilon must be > 0 m, got " + str(cgal_epsilon));
+  require(cgal_cluster_epsilon > 0,
+          "cgal_cluster_epsilon must be > 0 m, got " + str(cgal_cluster_epsilon));
+  require(cgal_max_points >= 100,
+          "cgal_max_points must be >= 100, got " + std::to_string(cgal_max_points));
+  require(cgal_min_fraction >= 0 && cgal_min_fraction < 1,
+          "cgal_min_fraction must be in [0, 1), got " + str(cgal_min_fraction));
+  require(cgal_normal_threshold > 0 && cgal_normal_threshold < 1,
+          "cgal_normal_threshold must be in (0, 1), got " + str(cgal_normal_threshold));
+  require(curved_max_normal_angle > 0 && curved_max_normal_angle < M_PI / 2,
+          "curved_max_normal_angle must be in (0, pi/2) rad, got " + str(curved_max_normal_angle));
+  require(min_curved_points >= 4,
+          "min_curved_points must be >= 4, got " + std::to_string(min_curved_points));
+  require(min_sphere_radius > 0 && min_sphere_radius < max_sphere_radius,
+          "sphere radii must satisfy 0 < min_sphere_radius < max_sphere_radius (m)");
+  require(min_cylinder_radius > 0 && min_cylinder_radius < max_cylinder_radius,
+          "cylinder radii must satisfy 0 < min_cylinder_radius < max_cylinder_radius (m)");
+  require(min_cone_half_angle > 0 && min_cone_half_angle < max_cone_half_angle &&
+              max_cone_half_angle < M_PI / 2,
+          "cone half angles must satisfy 0 < min_cone_half_angle < max_cone_half_angle < pi/2");
+  require(plane_rms_ratio >= 1, "plane_rms_ratio must be >= 1, got " + str(plane_rms_ratio));
+  require(cylinder_rms_ratio >= 1,
+          "cylinder_rms_ratio must be >= 1, got " + str(cylinder_rms_ratio));
+  require(max_rms_factor > 0 && max_rms_factor <= 10,
+          "max_rms_factor must be in (0, 10], got " + str(max_rms_factor));
+}
+
+QuadricSegmenter::QuadricSegmenter(const Params& params) : params_(params) {
+  params_.validate();
+}
+
+namespace {
+
+// The segmentation proper, on the grid of the cloud it is given.
+Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
+                         const QuadricSegmenter::Params& p) {
+  Segmentation result;
+  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+  result.labels = cv::Mat::zeros(height, width, CV_16UC1);
+  if (cloud.empty())
+    return result;
+
+  Frame frame{cloud, width, height, std::vector<std::uint8_t>(cloud.size(), 0),
+              std::vector<std::uint8_t>(cloud.size(), 0)};
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const pcl::PointNormal& q = cloud.points[i];
+    frame.valid[i] = std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+                     std::isfinite(q.normal_x) && std::isfinite(q.normal_y) &&
+                     std::isfinite(q.normal_z) && q.z >= p.min_range && q.z <= p.max_range;
+  }
+
+  const ShapeRefiner refiner(p.refiner);
+  auto accept = [&](const PrimitiveShape& shape, const std::vector<int>& indices,
+                    const ShapeRefiner::Result& fit) {
+    QuadricDetection detection;
+    detection.shape = fit.shape;
+    const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
+    centreOnSupport(detection.shape, points);
+    (void)shape;
+    detection.covariance = fit.covariance;
+    detection.num_points = static_cast<int>(indices.size());
+    detection.fit_rms = rmsDistance(detection.shape, points);
+    detection.label = static_cast<std::uint16_t>(result.detections.size() + 1);
+    detection.roi = roiOf(indices, width);
+    const Eigen::Isometry3d T_quadric_frame = detection.shape.poseInFrame().inverse();
+    detection.extent_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+    detection.extent_max = -detection.extent_min;
+    for (const auto& q : points) {
+      const Eigen::Vector3d local = T_quadric_frame * q;
+      detection.extent_min = detection.extent_min.cwiseMin(local);
+      detection.extent_max = detection.extent_max.cwiseMax(local);
+    }
+    for (int i : indices) {
+      frame.used[i] = 1;
+      result.labels.at<std::uint16_t>(i / width, i % width) = detection.label;
+    }
+    result.detections.push_back(std::move(detection));
+  };
+
+  auto start = std::chrono::steady_clock::now();
+  // 1. Planes from the image grid.
+  const PlaneRegionGrower grower(p.planes);
+  for (const PlaneRegionGrower::Region& region : grower.grow(cloud, frame.valid, frame.used)) {
+    const ShapeRefiner::Result fit =
+        refiner.evaluate(region.plane, pointsOf(cloud, region.indices));
+    accept(fit.shape, region.indices, fit);
+  }
+
+  result.timings.planes_ms = msSince(start);
+  start = std::chrono::steady_clock::now();
+
+  // 2. Curved candidates from CGAL, run per image-grid connected component of the free points (on
+  // a sub-sample): small inputs with a support threshold relative to their size converge in few
+  // RANSAC rounds, and a shape never spans two separate objects.
+  if (!(p.detect_spheres || p.detect_cylinders || p.detect_cones))
+    return result;
+  CgalShapeDetector::Params cgal;
+  cgal.planes = true;  // absorbs small planar patches that would otherwise become wide cylinders
+  cgal.spheres = p.detect_spheres;
+  cgal.cylinders = p.detect_cylinders;
+  cgal.cones = p.detect_cones;
+  cgal.probability = p.cgal_probability;
+  cgal.epsilon = p.cgal_epsilon;
+  cgal.cluster_epsilon = p.cgal_cluster_epsilon;
+  cgal.normal_threshold = p.cgal_normal_threshold;
+  cgal.random_seed = p.random_seed;
+  std::vector<Eigen::Vector3d> sample_points, sample_normals;
+  std::vector<int> sample_pixel;
+  std::vector<CgalShapeDetector::Shape> candidates;
+  for (const std::vector<int>& component : freeComponents(frame, p)) {
+    if (static_cast<int>(component.size()) < p.min_curved_points)
+      continue;
+    const std::size_t first = sample_points.size();
+    // A stride that keeps the component's sample within cgal_max_points.
+    const int stride = std::max(
+        p.cgal_stride, static_cast<int>(std::ceil(
+                           std::sqrt(static_cast<double>(component.size()) / p.cgal_max_points))));
+    for (int i : component) {
+      if ((i % width) % stride != 0 || (i / width) % stride != 0)
+        continue;
+      sample_points.push_back(pointOf(cloud.points[i]));
+      sample_normals.push_back(normalOf(cloud.points[i]).normalized());
+      sample_pixel.push_back(i);
+    }
+    const int count = static_cast<int>(sample_points.size() - first);
+    cgal.min_points =
+        std::max(p.cgal_min_points, static_cast<int>(std::ceil(p.cgal_min_fraction * count)));
+    if (count < cgal.min_points)
+      continue;
+    const std::vector<Eigen::Vector3d> points(sample_points.begin() + first, sample_points.end());
+    const std::vector<Eigen::Vector3d> normals(sample_normals.begin() + first,
+                                               sample_normals.end());
+    for (CgalShapeDetector::Shape& shape : CgalShapeDetector(cgal).detect(points, normals)) {
+      for (int& k : shape.indices)
+        k += static_cast<int>(first);
+      candidates.push_back(std::move(shape));
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    return a.indices.size() > b.indices.size();
+  });
+
+  result.timings.ransac_points = static_cast<int>(sample_points.size());
+  result.timings.ransac_candidates = static_cast<int>(candidates.size());
+  result.timings.ransac_ms = msSince(start);
+  start = std::chrono::steady_clock::now();
+
+  // 3. Verify, refine and re-assign each curved candidate, biggest first.
+  for (const CgalShapeDetector::Shape& candidate : candidates) {
+    if (candidate.shape.quadric_class == QuadricClass::kPlane)
+      continue;
+    std::vector<Eigen::Vector3d> support;
+    std::vector<int> pixels;
+    for (int k : candidate.indices) {
+      if (frame.used[sample_pixel[k]])
+        continue;
+      support.push_back(sample_points[k]);
+      pixels.push_back(sample_pixel[k]);
+    }
+    if (static_cast<int>(support.size()) < p.cgal_min_points)
+      continue;
+    PrimitiveShape shape = candidate.shape;
+    if (shape.quadric_class == QuadricClass::kCone && shape.size < p.min_cone_half_angle)
+      shape = cylinderFromCone(shape, support);
+    ShapeRefiner::Result fit = refiner.refine(shape, support);
+    const ImageRoi roi = grown(roiOf(pixels, width), 4 * p.cgal_stride, width, height);
+
+    std::vector<int> indices;
+    for (int pass = 0; pass < 2; ++pass) {
+      if (!plausible(fit.shape, p))
+        break;
+      indices = assignLargestComponent(frame, fit.shape, roi, p);
+      if (static_cast<int>(indices.size()) < p.min_curved_points) {
+        indices.clear();
+        break;
+      }
+      const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
+      fit = refiner.refine(fit.shape, points);
+      // Model selection: a simpler class that fits almost as well wins (a thin cone is a
+      // cylinder; a wide cone or a cylinder on a sphere cap is a sphere).
+      if (fit.shape.quadric_class == QuadricClass::kCone) {
+        const ShapeRefiner::Result as_cylinder =
+            refiner.refine(cylinderFromCone(fit.shape, points), points);
+        if (as_cylinder.rms < p.cylinder_rms_ratio * fit.rms && plausible(as_cylinder.shape, p))
+          fit = as_cylinder;
+      }
+      if (fit.shape.quadric_class != QuadricClass::kSphere && p.detect_spheres) {
+        const ShapeRefiner::Result as_sphere = refiner.refine(fitSphereAlgebraic(points), points);
+        if (as_sphere.rms < p.cylinder_rms_ratio * fit.rms && plausible(as_sphere.shape, p))
+          fit = as_sphere;
+      }
+    }
+    if (indices.empty() || !plausible(fit.shape, p))
+      continue;
+    const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
+    // Degeneracy: a near-flat surface is a plane, not a curved primitive.
+    const double plane_rms = rmsDistance(fitPlane(points), points);
+    if (plane_rms < p.plane_rms_ratio * fit.rms)
+      continue;
+    const double z = medianDepth(cloud, indices);
+    if (fit.rms >
+        p.max_rms_factor * depthThreshold(z, p.planes.distance_factor, p.planes.min_distance))
+      continue;
+    accept(fit.shape, indices, fit);
+  }
+  result.timings.verify_ms = msSince(start);
+  return result;
+}
+
+// The parameters of a grid decimated by d: counts of points scale with 1 / d^2, strides with 1 / d.
+QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) {
+  QuadricSegmenter::Params c = p;
+  c.planes.min_points = std::max(3, p.planes.min_points / (d * d));
+  c.min_curved_points = std::max(4, p.min_curved_points / (d * d));
+  c.planes.seed_stride = std::max(1, p.planes.seed_stride / d);
+  c.cgal_stride = std::max(1, (p.cgal_stride + d / 2) / d);
+  c.decimation = 1;
+  return c;
+}
+
+bool validPoint(const pcl::PointNormal& q, const QuadricSegmenter::Params& p) {
+  return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+         std::isfinite(q.normal_x) && std::isfinite(q.normal_y) && std::isfinite(q.normal_z) &&
+         q.z >= p.min_range && q.z <= p.max_range;
+}
+
+// Full-resolution labels from a segmentation of the grid decimated by d: each valid pixel takes
+// the label of a neighbouring coarse sample whose surface it fits (distance threshold and normal
+// agreement, as on the coarse grid); support, ROI, extent and covariance follow the full-resolution
+// points.
+Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
+                      const QuadricSegmenter::Params& p) {
+  Segmentation result;
+  result.timings = coarse.timings;
+  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+  result.labels = cv::Mat::zeros(height, width, CV_16UC1);
+  const int n = static_cast<int>(coarse.detections.size());
+  std::vector<Eigen::Isometry3d> T_quadric_camera(n);
+  std::vector<double> cos_angle(n);
+  for (int k = 0; k < n; ++k) {
+    T_quadric_camera[k] = coarse.detections[k].shape.poseInFrame().inverse();
+    cos_angle[k] = std::cos(coarse.detections[k].shape.quadric_class == QuadricClass::kPlane
+                                ? p.planes.max_normal_angle
+                                : p.curved_max_normal_angle);
+  }
+  std::vector<int> count(n, 0);
+  std::vector<Eigen::Vector3d> lo(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
+  std::vector<Eigen::Vector3d> hi(n,
+                                  Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
+  std::vector<ImageRoi> box(n, ImageRoi{width, height, -1, -1});  // x, y min; width, height = max
+  const int cw = coarse.labels.cols, ch = coarse.labels.rows;
+  for (int v = 0; v < height; ++v) {
+    const int cv0 = std::min(v / d, ch - 1), cv1 = std::min(v / d + 1, ch - 1);
+    for (int u = 0; u < width; ++u) {
+      const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
+      if (!validPoint(q, p))
+        continue;
+      const int cu0 = std::min(u / d, cw - 1), cu1 = std::min(u / d + 1, cw - 1);
+      const std::uint16_t candidates[4] = {
+          coarse.labels.at<std::uint16_t>(cv0, cu0), coarse.labels.at<std::uint16_t>(cv0, cu1),
+          coarse.labels.at<std::uint16_t>(cv1, cu0), coarse.labels.at<std::uint16_t>(cv1, cu1)};
+      const Eigen::Vector3d point = pointOf(q);
+      const double threshold = depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
+      int best = 0;
+      double best_distance = threshold;
+      for (int c = 0; c < 4; ++c) {
+        const int label = candidates[c];
+        if (label == 0 || label == best)
+          continue;
+        const PrimitiveShape& shape = coarse.detections[label - 1].shape;
+        const double distance = std::abs(shape.distance(point));
+        if (distance >= best_distance)
+          continue;
+        if (std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
+          continue;
+        best = label;
+        best_distance = distance;
+      }
+      if (best == 0)
+        continue;
+      result.labels.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(best);
+      const int k = best - 1;
+      ++count[k];
+      const Eigen::Vector3d local = T_quadric_camera[k] * point;
+      lo[k] = lo[k].cwiseMin(local);
+      hi[k] = hi[k].cwiseMax(local);
+      box[k].x_offset = std::min(box[k].x_offset, u);
+      box[k].y_offset = std::min(box[k].y_offset, v);
+      box[k].width = std::max(box[k].width, u);
+      box[k].height = std::max(box[k].height, v);
+    }
+  }
+  // Keep the detections with support, renumbered 1..m.
+  std::vector<std::uint16_t> relabel(n + 1, 0);
+  for (int k = 0; k < n; ++k) {
+    if (count[k] == 0)
+      continue;
+    QuadricDetection detection = coarse.detections[k];
+    detection.label = static_cast<std::uint16_t>(result.detections.size() + 1);
+    relabel[k + 1] = detection.label;
+    // More points of the same noise: the covariance shrinks with the support.
+    detection.covariance *= static_cast<double>(detection.num_points) / count[k];
+    detection.num_points = count[k];
+    detection.extent_min = lo[k];
+    detection.extent_max = hi[k];
+    detection.roi = ImageRoi{box[k].x_offset, box[k].y_offset, box[k].width - box[k].x_offset + 1,
+                             box[k].height - box[k].y_offset + 1};
+    result.detections.push_back(std::move(detection));
+  }
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u) {
+      std::uint16_t& label = result.labels.at<std::uint16_t>(v, u);
+      label = relabel[label];
+    }
+  return result;
+}
+
+}  // namespace
+
+Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& cloud) const {
+  if (!cloud.isOrganized() && !cloud.empty())
+    throw std::invalid_argument("QuadricSegmenter: the cloud must be organized");
+  const int d = params_.decimation;
+  if (d == 1 || cloud.width < static_cast<std::uint32_t>(4 * d) ||
+      cloud.height < static_cast<std::uint32_t>(4 * d))
+    return segmentGrid(cloud, params_);
+  const auto start = std::chrono::steady_clock::now();
+  pcl::PointCloud<pcl::PointNormal> grid(cloud.width / d, cloud.height / d);
+  grid.is_dense = false;
+  for (std::uint32_t r = 0; r < grid.height; ++r)
+    for (std::uint32_t c = 0; c < grid.width; ++c)
+      grid(c, r) = cloud(c * d, r * d);
+  const double decimate_ms = msSince(start);
+  Segmentation coarse = segmentGrid(grid, coarseParams(params_, d));
+  const auto upsample_start = std::chrono::steady_clock::now();
+  Segmentation result = upsample(cloud, std::move(coarse), d, params_);
+  result.timings.upsample_ms = decimate_ms + msSince(upsample_start);
+  return result;
+}
+
+cv::Mat colouriseLabels(const cv::Mat& labels) {
+  cv::Mat rgb(labels.rows, labels.cols, CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int y = 0; y < labels.rows; ++y) {
+    for (int x = 0; x < labels.cols; ++x) {
+      const unsigned label = labels.at<std::uint16_t>(y, x);
+      if (label == 0)
+        continue;
+      // Golden-angle hue steps give neighbouring labels distinct colours.
+      const double hue = std::fmod(label * 137.508, 360.0) / 60.0;
+      const double f = hue - std::floor(hue);
+      const double s = 0.85, v = 0.95;
+      const double pp = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+      double r = v, g = t, b = pp;
+      switch (static_cast<int>(hue) % 6) {
+        case 1:
+          r = q;
+          g = v;
+          b = pp;
+          break;
+        case 2:
+          r = pp;
+          g = v;
+          b = t;
+          break;
+        case 3:
+          r = pp;
+          g = q;
+          b = v;
+          break;
+        case 4:
+          r = t;
+          g = pp;
+          b = v;
+          break;
+        case 5:
+          r = v;
+          g = pp;
+          b = q;
+          break;
+        default:
+          break;
+      }
+      rgb.at<cv::Vec3b>(y, x) =
+          cv::Vec3b(static_cast<unsigned char>(255 * r), static_cast<unsigned char>(255 * g),
+                    static_cast<unsigned char>(255 * b));
+    }
+  }
+  return rgb;
+}
+
+}  // namespace quadric_slam

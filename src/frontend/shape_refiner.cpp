@@ -1,0 +1,190 @@
+#include "quadric_slam/frontend/shape_refiner.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace quadric_slam {
+
+void ShapeRefiner::Params::validate() const {
+  if (max_iterations < 1 || max_iterations > 100)
+    throw std::invalid_argument("ShapeRefiner: max_iterations must be in [1, 100], got " +
+                                std::to_string(max_iterations));
+  if (!(relative_tolerance > 0 && relative_tolerance < 1))
+    throw std::invalid_argument("ShapeRefiner: relative_tolerance must be in (0, 1), got " +
+                                std::to_string(relative_tolerance));
+  if (max_points < 10 || max_points > 10000000)
+    throw std::invalid_argument("ShapeRefiner: max_points must be in [10, 1e7], got " +
+                                std::to_string(max_points));
+}
+
+ShapeRefiner::ShapeRefiner(const Params& params) : params_(params) {
+  params_.validate();
+}
+
+namespace {
+
+Eigen::VectorXd residuals(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
+  Eigen::VectorXd r(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    r[i] = shape.distance(points[i]);
+  return r;
+}
+
+// Jacobian of the distances with respect to the minimal coordinates, by central differences.
+Eigen::MatrixXd jacobian(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
+  const int k = minimalDimension(shape.quadric_class);
+  Eigen::MatrixXd J(points.size(), k);
+  constexpr double h = 1e-6;
+  for (int j = 0; j < k; ++j) {
+    Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
+    delta[j] = h;
+    const Eigen::VectorXd plus = residuals(perturb(shape, delta), points);
+    delta[j] = -h;
+    const Eigen::VectorXd minus = residuals(perturb(shape, delta), points);
+    J.col(j) = (plus - minus) / (2 * h);
+  }
+  return J;
+}
+
+std::vector<Eigen::Vector3d> subsample(const std::vector<Eigen::Vector3d>& all_points,
+                                       int max_points) {
+  if (static_cast<int>(all_points.size()) <= max_points)
+    return all_points;
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(max_points);
+  const double step = static_cast<double>(all_points.size()) / max_points;
+  for (int i = 0; i < max_points; ++i)
+    points.push_back(all_points[static_cast<std::size_t>(i * step)]);
+  return points;
+}
+
+// Covariance of the fit: sigma^2 (J^T J)^-1, J over all points (the sub-sample's normal matrix
+// scaled by N / n), sigma^2 the residual variance.
+ShapeRefiner::Result covarianceOf(const PrimitiveShape& shape,
+                                  const std::vector<Eigen::Vector3d>& points,
+                                  std::size_t all_points) {
+  ShapeRefiner::Result result;
+  const int k = minimalDimension(shape.quadric_class);
+  const double cost = residuals(shape, points).squaredNorm();
+  const Eigen::MatrixXd J = jacobian(shape, points);
+  Eigen::MatrixXd H = J.transpose() * J;
+  H *= static_cast<double>(all_points) / static_cast<double>(points.size());
+  const double sigma2 = cost / (static_cast<double>(points.size()) - k);
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
+  result.shape = shape;
+  result.rms = std::sqrt(cost / points.size());
+  if (eig.info() != Eigen::Success ||
+      eig.eigenvalues().minCoeff() <= 1e-12 * eig.eigenvalues().maxCoeff()) {
+    result.covariance = Eigen::MatrixXd::Identity(k, k) * 1e6;
+    return result;
+  }
+  result.covariance = sigma2 * H.inverse();
+  result.ok = true;
+  return result;
+}
+
+}  // namespace
+
+ShapeRefiner::Result ShapeRefiner::refine(const PrimitiveShape& initial,
+                                          const std::vector<Eigen::Vector3d>& all_points) const {
+  Result result;
+  result.shape = initial;
+  const int k = minimalDimension(initial.quadric_class);
+  if (static_cast<int>(all_points.size()) <= k)
+    return result;
+
+  const std::vector<Eigen::Vector3d> points = subsample(all_points, params_.max_points);
+
+  PrimitiveShape shape = initial;
+  Eigen::VectorXd r = residuals(shape, points);
+  double cost = r.squaredNorm();
+  double lambda = 1e-4;
+  for (int it = 0; it < params_.max_iterations; ++it) {
+    const Eigen::MatrixXd J = jacobian(shape, points);
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::VectorXd g = J.transpose() * r;
+    bool improved = false;
+    for (int attempt = 0; attempt < 10 && !improved; ++attempt) {
+      Eigen::MatrixXd A = H;
+      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-12);
+      const Eigen::VectorXd delta = A.ldlt().solve(-g);
+      if (!delta.allFinite())
+        break;
+      const PrimitiveShape candidate = perturb(shape, delta);
+      const Eigen::VectorXd r_new = residuals(candidate, points);
+      const double cost_new = r_new.squaredNorm();
+      if (std::isfinite(cost_new) && cost_new < cost) {
+        const double decrease = (cost - cost_new) / std::max(cost, 1e-300);
+        shape = candidate;
+        r = r_new;
+        cost = cost_new;
+        lambda = std::max(lambda / 10, 1e-9);
+        improved = true;
+        if (decrease < params_.relative_tolerance)
+          it = params_.max_iterations;
+      } else {
+        lambda *= 10;
+      }
+    }
+    if (!improved)
+      break;
+  }
+
+  return covarianceOf(shape, points, all_points.size());
+}
+
+ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
+                                            const std::vector<Eigen::Vector3d>& all_points) const {
+  Result result;
+  result.shape = shape;
+  if (static_cast<int>(all_points.size()) <= minimalDimension(shape.quadric_class))
+    return result;
+  return covarianceOf(shape, subsample(all_points, params_.max_points), all_points.size());
+}
+
+PrimitiveShape fitPlane(const std::vector<Eigen::Vector3d>& points) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points)
+    mean += p;
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero();
+  for (const auto& p : points)
+    C += (p - mean) * (p - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
+  Eigen::Vector3d n = eig.eigenvectors().col(0);
+  if (n.dot(mean) > 0)
+    n = -n;
+  PrimitiveShape s = PrimitiveShape::plane(n, n.dot(mean));
+  s.point = mean;
+  return s;
+}
+
+PrimitiveShape fitSphereAlgebraic(const std::vector<Eigen::Vector3d>& points) {
+  // |p|^2 + a.p + b = 0 -> centre -a/2, radius sqrt(|a|^2/4 - b).
+  Eigen::MatrixXd A(points.size(), 4);
+  Eigen::VectorXd y(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    A.row(i) << points[i].x(), points[i].y(), points[i].z(), 1.0;
+    y[i] = -points[i].squaredNorm();
+  }
+  const Eigen::Vector4d x = (A.transpose() * A).ldlt().solve(A.transpose() * y);
+  const Eigen::Vector3d centre = -0.5 * x.head<3>();
+  const double r2 = centre.squaredNorm() - x[3];
+  return PrimitiveShape::sphere(centre, std::sqrt(std::max(r2, 0.0)));
+}
+
+double rmsDistance(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
+  if (points.empty())
+    return 0.0;
+  double sum = 0;
+  for (const auto& p : points) {
+    const double d = shape.distance(p);
+    sum += d * d;
+  }
+  return std::sqrt(sum / points.size());
+}
+
+}  // namespace quadric_slam

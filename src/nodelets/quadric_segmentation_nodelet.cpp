@@ -1,0 +1,204 @@
+// quadric_segmentation: organized cloud with normals -> quadric observations (planes, spheres,
+// cylinders, cones) in the camera frame, with the core QuadricSegmenter.
+//
+// Subscribes  points_normals (sensor_msgs/PointCloud2, organized, fields x y z normal_x normal_y
+//             normal_z [curvature], NaN where unknown; e.g. from quadric_slam/NormalEstimation)
+// Parameters  config/segmentation.yaml (every key documented there)
+// Publishes   observations (quadric_slam/QuadricObservationArray, the cloud's stamp and frame; an
+//             empty array when the frame holds no quadric, e.g. an empty or all-NaN cloud)
+//             ~segmentation_image (sensor_msgs/Image rgb8, a colour per segment; only computed
+//             while subscribed)
+//             ~segmented_cloud (sensor_msgs/PointCloud2 x y z label, organized, label 0 =
+//             unassigned; only computed while subscribed)
+//             /diagnostics (health: frames processed and dropped, last reason)
+// A cloud without normal fields or not organized gets a throttled error and is dropped.
+#include <nodelet/nodelet.h>
+#include <pcl_conversions/pcl_conversions.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/image_encodings.h>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cstring>
+#include <memory>
+#include <pluginlib/class_list_macros.hpp>
+#include <set>
+#include <string>
+
+#include "quadric_slam/QuadricObservationArray.h"
+#include "quadric_slam/frontend/quadric_segmenter.h"
+#include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/ros/diagnostics.h"
+#include "quadric_slam/ros/params.h"
+
+namespace quadric_slam {
+
+namespace {
+
+// The observation message of one detection (msg/QuadricSurface.msg conventions: pose
+// T_camera_quadric, scale = diag(S), shape vector; covariance row-major in the Table II minimal
+// space).
+QuadricObservation toMessage(const QuadricDetection& d) {
+  QuadricObservation o;
+  const QuadricClass c = d.shape.quadric_class;
+  o.surface.quadric_class = static_cast<std::uint8_t>(c);
+  const Eigen::Vector4d sigma = defaultSignature(c);
+  for (int i = 0; i < 4; ++i)
+    o.surface.signature[i] = static_cast<std::int8_t>(sigma[i]);
+  const Eigen::Isometry3d T_camera_quadric = d.shape.poseInFrame();
+  const Eigen::Quaterniond q(T_camera_quadric.linear());
+  o.surface.pose.position.x = T_camera_quadric.translation().x();
+  o.surface.pose.position.y = T_camera_quadric.translation().y();
+  o.surface.pose.position.z = T_camera_quadric.translation().z();
+  o.surface.pose.orientation.w = q.w();
+  o.surface.pose.orientation.x = q.x();
+  o.surface.pose.orientation.y = q.y();
+  o.surface.pose.orientation.z = q.z();
+  const Eigen::Vector3d scale = d.shape.scale();
+  for (int i = 0; i < 3; ++i)
+    o.surface.scale[i] = scale[i];
+  o.surface.shape = d.shape.shapeVector();
+  o.surface.extent_min.x = d.extent_min.x();
+  o.surface.extent_min.y = d.extent_min.y();
+  o.surface.extent_min.z = d.extent_min.z();
+  o.surface.extent_max.x = d.extent_max.x();
+  o.surface.extent_max.y = d.extent_max.y();
+  o.surface.extent_max.z = d.extent_max.z();
+  o.minimal_dimension = static_cast<std::uint8_t>(minimalDimension(c));
+  for (int r = 0; r < d.covariance.rows(); ++r)
+    for (int col = 0; col < d.covariance.cols(); ++col)
+      o.covariance.push_back(d.covariance(r, col));
+  o.num_points = static_cast<std::uint32_t>(d.num_points);
+  o.label = d.label;
+  o.image_roi.x_offset = static_cast<std::uint32_t>(d.roi.x_offset);
+  o.image_roi.y_offset = static_cast<std::uint32_t>(d.roi.y_offset);
+  o.image_roi.width = static_cast<std::uint32_t>(d.roi.width);
+  o.image_roi.height = static_cast<std::uint32_t>(d.roi.height);
+  o.fit_rms = static_cast<float>(d.fit_rms);
+  return o;
+}
+
+// Empty when the cloud has the fields and layout the segmenter needs, else the problem.
+std::string cloudProblem(const sensor_msgs::PointCloud2& cloud) {
+  std::set<std::string> fields;
+  for (const auto& f : cloud.fields)
+    fields.insert(f.name);
+  std::string missing;
+  for (const char* name : {"x", "y", "z", "normal_x", "normal_y", "normal_z"})
+    if (!fields.count(name))
+      missing += std::string(missing.empty() ? "" : ", ") + name;
+  if (!missing.empty())
+    return "the cloud lacks the field(s) " + missing +
+           " (points_normals must carry normals, e.g. from quadric_slam/NormalEstimation)";
+  if (cloud.height <= 1 && cloud.width > 1)
+    return "the cloud is not organized (height 1); an organized depth-image cloud is required";
+  if (static_cast<std::size_t>(cloud.row_step) * cloud.height > cloud.data.size() ||
+      static_cast<std::size_t>(cloud.point_step) * cloud.width > cloud.row_step)
+    return "malformed cloud: data smaller than row_step * height";
+  return "";
+}
+
+}  // namespace
+
+class QuadricSegmentationNodelet : public nodelet::Nodelet {
+ private:
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& private_nh = getPrivateNodeHandle();
+
+    ParamLog log;
+    QuadricSegmenter::Params params;
+    int queue_size = 2;
+    try {
+      const RosParamReader reader(private_nh);
+      readSegmentationParams(reader, params, log);
+      readParam(reader, "queue_size", queue_size, log);
+      segmenter_ = std::make_unique<QuadricSegmenter>(params);
+    } catch (const std::invalid_argument& e) {
+      NODELET_FATAL("quadric_segmentation: invalid parameter: %s", e.what());
+      throw;
+    }
+    NODELET_INFO("quadric_segmentation parameters:%s", log.str().c_str());
+
+    diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, "quadric_slam: quadric_segmentation");
+    observations_pub_ = nh.advertise<QuadricObservationArray>("observations", queue_size);
+    image_pub_ = private_nh.advertise<sensor_msgs::Image>("segmentation_image", 1);
+    cloud_pub_ = private_nh.advertise<sensor_msgs::PointCloud2>("segmented_cloud", 1);
+    cloud_sub_ =
+        nh.subscribe("points_normals", queue_size, &QuadricSegmentationNodelet::onCloud, this);
+  }
+
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::string problem = cloudProblem(*msg);
+    if (!problem.empty()) {
+      NODELET_ERROR_THROTTLE(5.0, "quadric_segmentation: dropping cloud: %s", problem.c_str());
+      diagnostics_->frameDropped(problem);
+      return;
+    }
+    pcl::PointCloud<pcl::PointNormal> cloud;
+    pcl::fromROSMsg(*msg, cloud);
+    if (cloud.height <= 1 && !cloud.empty()) {
+      // A single point or a 1 x N row: organized enough for the segmenter's grid.
+      cloud.height = 1;
+      cloud.width = static_cast<std::uint32_t>(cloud.size());
+    }
+    const Segmentation segmentation = segmenter_->segment(cloud);
+
+    auto out = boost::make_shared<QuadricObservationArray>();
+    out->header = msg->header;
+    for (const QuadricDetection& d : segmentation.detections)
+      out->observations.push_back(toMessage(d));
+    observations_pub_.publish(out);
+
+    if (image_pub_.getNumSubscribers() > 0)
+      publishImage(segmentation, msg->header);
+    if (cloud_pub_.getNumSubscribers() > 0)
+      publishCloud(cloud, segmentation, msg->header);
+    diagnostics_->frameProcessed(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
+  }
+
+  void publishImage(const Segmentation& segmentation, const std_msgs::Header& header) {
+    const cv::Mat rgb = colouriseLabels(segmentation.labels);
+    auto image = boost::make_shared<sensor_msgs::Image>();
+    image->header = header;
+    image->height = static_cast<std::uint32_t>(rgb.rows);
+    image->width = static_cast<std::uint32_t>(rgb.cols);
+    image->encoding = sensor_msgs::image_encodings::RGB8;
+    image->step = static_cast<std::uint32_t>(rgb.cols * 3);
+    image->data.resize(static_cast<std::size_t>(image->step) * rgb.rows);
+    for (int r = 0; r < rgb.rows; ++r)
+      std::memcpy(&image->data[static_cast<std::size_t>(r) * image->step], rgb.ptr(r), image->step);
+    image_pub_.publish(image);
+  }
+
+  void publishCloud(const pcl::PointCloud<pcl::PointNormal>& cloud,
+                    const Segmentation& segmentation, const std_msgs::Header& header) {
+    pcl::PointCloud<pcl::PointXYZL> labelled(cloud.width, cloud.height);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      labelled.points[i].x = cloud.points[i].x;
+      labelled.points[i].y = cloud.points[i].y;
+      labelled.points[i].z = cloud.points[i].z;
+      labelled.points[i].label = segmentation.labels.at<std::uint16_t>(
+          static_cast<int>(i / cloud.width), static_cast<int>(i % cloud.width));
+    }
+    labelled.is_dense = false;
+    auto out = boost::make_shared<sensor_msgs::PointCloud2>();
+    pcl::toROSMsg(labelled, *out);
+    out->header = header;
+    cloud_pub_.publish(out);
+  }
+
+  std::unique_ptr<QuadricSegmenter> segmenter_;
+  std::unique_ptr<NodeletDiagnostics> diagnostics_;
+  ros::Subscriber cloud_sub_;
+  ros::Publisher observations_pub_, image_pub_, cloud_pub_;
+};
+
+}  // namespace quadric_slam
+
+PLUGINLIB_EXPORT_CLASS(quadric_slam::QuadricSegmentationNodelet, nodelet::Nodelet)

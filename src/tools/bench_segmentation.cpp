@@ -1,0 +1,254 @@
+// bench_segmentation: time of QuadricSegmenter per 640x480 frame (normals excluded) over the real
+// frames in ../shared/data (OSD mosd_cylinders PCDs, TUM depth PNGs) and rendered synthetic frames,
+// against the baseline the paper uses: CGAL Efficient RANSAC with plane, sphere, cylinder and cone
+// on all points of the full frame.
+//
+//   bench_segmentation [--data DIR] [--repeats N (3)] [--synthetic N (10)] [--baseline-frames N
+//   (8)]
+//
+// Prints median and p95 per set, the baseline's, their ratio, and the machine load (uptime).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "quadric_slam/frontend/cgal_shape_detector.h"
+#include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/frontend/primitive_scene_renderer.h"
+#include "quadric_slam/frontend/quadric_segmenter.h"
+#include "quadric_slam/frontend/segmentation_input.h"
+#include "quadric_slam/frontend/segmenter_params.h"
+
+namespace qs = quadric_slam;
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty())
+    return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5));
+  return v[i];
+}
+
+struct Frame {
+  std::string name;
+  pcl::PointCloud<pcl::PointNormal> cloud;
+};
+
+qs::CameraIntrinsics intrinsics(double fx, double fy, double cx, double cy) {
+  qs::CameraIntrinsics k;
+  k.fx = fx;
+  k.fy = fy;
+  k.cx = cx;
+  k.cy = cy;
+  return k;
+}
+
+std::vector<Frame> realFrames(const std::string& data, const qs::NormalEstimator& normals) {
+  std::vector<Frame> frames;
+  auto add = [&](const std::string& path, const qs::CameraIntrinsics& k, double scale) {
+    try {
+      frames.push_back({path, normals.compute(qs::loadOrganizedCloud(path, k, scale))});
+    } catch (const std::exception&) {
+      // not a depth frame (e.g. an RGB PNG)
+    }
+  };
+  const std::vector<std::pair<std::string, qs::CameraIntrinsics>> tum = {
+      {"fr1_xyz", intrinsics(517.3, 516.5, 318.6, 255.3)},
+      {"fr2_desk", intrinsics(520.9, 521.0, 325.1, 249.7)},
+      {"fr3_long_office_household", intrinsics(535.4, 539.2, 320.1, 247.6)}};
+  for (const auto& [sequence, k] : tum) {
+    const fs::path dir = fs::path(data) / "tum_frames" / sequence;
+    if (!fs::exists(dir))
+      continue;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(dir))
+      if (e.path().extension() == ".png")
+        files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files)
+      add(f.string(), k, sequence == "fr2_desk" ? 5208.0 : 5000.0);
+  }
+  const fs::path osd = fs::path(data) / "mosd_cylinders";
+  if (fs::exists(osd)) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(osd))
+      if (e.path().extension() == ".pcd")
+        files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files)
+      add(f.string(), qs::CameraIntrinsics(), 1.0);
+  }
+  return frames;
+}
+
+// Desk-like rendered scenes: floor, wall, and a sphere, cylinder and cone at random places.
+std::vector<Frame> syntheticFrames(int count, const qs::NormalEstimator& normals) {
+  std::vector<Frame> frames;
+  qs::CameraIntrinsics k = intrinsics(525, 525, 319.5, 239.5);
+  k.width = 640;
+  k.height = 480;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> uni(-1, 1);
+  for (int i = 0; i < count; ++i) {
+    std::vector<qs::ScenePrimitive> scene(5);
+    scene[0].shape = qs::PrimitiveShape::plane(Eigen::Vector3d(0, -1, 0), -0.8);
+    scene[1].shape = qs::PrimitiveShape::plane(Eigen::Vector3d(0, 0, -1), -2.6);
+    scene[2].shape = qs::PrimitiveShape::sphere(
+        Eigen::Vector3d(-0.45 + 0.1 * uni(rng), 0.2 + 0.1 * uni(rng), 1.6 + 0.3 * uni(rng)),
+        0.12 + 0.04 * uni(rng));
+    scene[3].shape = qs::PrimitiveShape::cylinder(
+        Eigen::Vector3d(0.05 + 0.1 * uni(rng), 0.8, 1.8 + 0.3 * uni(rng)),
+        Eigen::Vector3d(0, -1, 0), 0.08 + 0.03 * uni(rng));
+    scene[3].axis_max = 0.5;
+    scene[4].shape =
+        qs::PrimitiveShape::cone(Eigen::Vector3d(0.55 + 0.1 * uni(rng), 0.3, 1.5 + 0.3 * uni(rng)),
+                                 Eigen::Vector3d(0, 1, 0), 0.4 + 0.1 * uni(rng));
+    scene[4].axis_min = 0.1;
+    scene[4].axis_max = 0.5;
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = (Eigen::AngleAxisd(0.15 * uni(rng), Eigen::Vector3d::UnitX()) *
+                  Eigen::AngleAxisd(0.15 * uni(rng), Eigen::Vector3d::UnitY()))
+                     .toRotationMatrix();
+    for (auto& p : scene)
+      p.shape = p.shape.transformed(T);
+    qs::RenderParams render;
+    render.seed = 100 + i;
+    const qs::RenderedFrame rendered = qs::renderPrimitives(scene, k, render);
+    qs::DepthImageView<float> view;
+    view.data = rendered.depth.data;
+    view.width = rendered.depth.cols;
+    view.height = rendered.depth.rows;
+    view.row_step_bytes = rendered.depth.step[0];
+    frames.push_back({"synthetic_" + std::to_string(i),
+                      normals.compute(qs::backProject(view, k, qs::BackProjectionParams()))});
+  }
+  return frames;
+}
+
+// The baseline: CGAL Efficient RANSAC, all four shapes, every point with a normal.
+double baselineMs(const pcl::PointCloud<pcl::PointNormal>& cloud, std::size_t& shapes) {
+  const auto t0 = Clock::now();
+  std::vector<Eigen::Vector3d> points, normals;
+  for (const auto& p : cloud.points) {
+    if (!std::isfinite(p.z) || !std::isfinite(p.normal_x))
+      continue;
+    points.emplace_back(p.x, p.y, p.z);
+    normals.emplace_back(p.normal_x, p.normal_y, p.normal_z);
+  }
+  qs::CgalShapeDetector::Params params;
+  params.planes = params.spheres = params.cylinders = params.cones = true;
+  params.probability = 0.05;
+  params.min_points = 500;
+  params.epsilon = 0.008;
+  params.cluster_epsilon = 0.03;
+  params.normal_threshold = 0.85;
+  shapes = qs::CgalShapeDetector(params).detect(points, normals).size();
+  return ms(t0, Clock::now());
+}
+
+void report(const char* name, const std::vector<double>& times) {
+  std::printf("%-28s n=%3zu  median %7.1f ms  p95 %7.1f ms\n", name, times.size(),
+              percentile(times, 0.5), percentile(times, 0.95));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string data = QUADRIC_SLAM_SHARED_DATA_DIR;
+  int repeats = 3, synthetic = 10, baseline_frames = 8;
+  qs::QuadricSegmenter::Params params;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string arg = argv[i], value = argv[i + 1];
+    if (arg == "--data")
+      data = value;
+    else if (arg == "--repeats")
+      repeats = std::atoi(value.c_str());
+    else if (arg == "--synthetic")
+      synthetic = std::atoi(value.c_str());
+    else if (arg == "--baseline-frames")
+      baseline_frames = std::atoi(value.c_str());
+    else if (arg == "--config")
+      params = qs::loadSegmenterParams(value);
+    else if (arg == "--set" && value.find('=') != std::string::npos)
+      qs::setSegmenterParam(params, value.substr(0, value.find('=')),
+                            std::atof(value.c_str() + value.find('=') + 1));
+    else {
+      std::fprintf(stderr,
+                   "usage: bench_segmentation [--data DIR] [--repeats N] [--synthetic N] "
+                   "[--baseline-frames N] [--config segmentation.yaml] [--set KEY=VALUE]...\n");
+      return 2;
+    }
+  }
+  const qs::NormalEstimator normals{qs::NormalEstimator::Params()};
+  const qs::QuadricSegmenter segmenter(params);
+  const std::vector<Frame> real = realFrames(data, normals);
+  const std::vector<Frame> synth = syntheticFrames(synthetic, normals);
+  std::printf("frames: %zu real (%s), %zu synthetic; %d repeats each\n", real.size(), data.c_str(),
+              synth.size(), repeats);
+
+  std::vector<double> real_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms, upsample_ms;
+  for (int r = 0; r < repeats; ++r) {
+    for (const auto* set : {&real, &synth}) {
+      for (const Frame& f : *set) {
+        const auto t0 = Clock::now();
+        const qs::Segmentation s = segmenter.segment(f.cloud);
+        const double t = ms(t0, Clock::now());
+        (set == &real ? real_ms : synth_ms).push_back(t);
+        all_ms.push_back(t);
+        planes_ms.push_back(s.timings.planes_ms);
+        ransac_ms.push_back(s.timings.ransac_ms);
+        verify_ms.push_back(s.timings.verify_ms);
+        upsample_ms.push_back(s.timings.upsample_ms);
+      }
+    }
+  }
+  std::vector<double> base_ms;
+  std::size_t base_shapes = 0;
+  const std::size_t step =
+      std::max<std::size_t>(1, (real.size() + synth.size()) / std::max(1, baseline_frames));
+  std::vector<const Frame*> everything;
+  for (const auto& f : real)
+    everything.push_back(&f);
+  for (const auto& f : synth)
+    everything.push_back(&f);
+  for (std::size_t i = 0; i < everything.size(); i += step) {
+    std::size_t shapes = 0;
+    base_ms.push_back(baselineMs(everything[i]->cloud, shapes));
+    base_shapes += shapes;
+  }
+
+  std::printf("QuadricSegmenter (normals excluded):\n");
+  report("  real frames", real_ms);
+  report("  synthetic frames", synth_ms);
+  report("  all frames", all_ms);
+  report("    stage: planes", planes_ms);
+  report("    stage: ransac", ransac_ms);
+  report("    stage: verification", verify_ms);
+  report("    stage: upsampling", upsample_ms);
+  std::printf("Baseline, CGAL Efficient RANSAC, 4 shapes, full frame (%zu shapes total):\n",
+              base_shapes);
+  report("  baseline frames", base_ms);
+  std::printf("speed-up (baseline median / all-frames median): %.1fx\n",
+              percentile(base_ms, 0.5) / std::max(1e-9, percentile(all_ms, 0.5)));
+  std::ifstream loadavg("/proc/loadavg");
+  std::string l1, l5, l15;
+  loadavg >> l1 >> l5 >> l15;
+  std::printf("machine load (1/5/15 min): %s %s %s on %u hardware threads\n", l1.c_str(),
+              l5.c_str(), l15.c_str(), std::thread::hardware_concurrency());
+  return 0;
+}

@@ -1,0 +1,99 @@
+// eval_segmentation: the segmenter over a synthetic sequence written by scripts/synth (TUM folder
+// with labels/<stamp>.png and quadrics_gt.yaml): per primitive with enough valid pixels, the share
+// of frames in which its class is detected on it, and the spurious detections per frame.
+//
+//   eval_segmentation DIR [--stride K (1)] [--max-frames N (all)] [--min-pixels P (2000)]
+//                         [--config segmentation.yaml]
+#include <yaml-cpp/yaml.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <string>
+
+#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/frontend/quadric_segmenter.h"
+#include "quadric_slam/frontend/segmentation_score.h"
+#include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/io/depth_png.h"
+#include "quadric_slam/io/map_yaml.h"
+
+namespace qs = quadric_slam;
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::string(argv[1]) == "--help") {
+    std::fprintf(stderr,
+                 "usage: eval_segmentation DIR [--stride K] [--max-frames N] [--min-pixels P] "
+                 "[--config segmentation.yaml]\n");
+    return 2;
+  }
+  const std::string dir = argv[1];
+  int stride = 1, max_frames = 1 << 30, min_pixels = 2000;
+  qs::QuadricSegmenter::Params params;
+  try {
+    for (int i = 2; i + 1 < argc; i += 2) {
+      const std::string arg = argv[i], value = argv[i + 1];
+      if (arg == "--stride")
+        stride = std::max(1, std::atoi(value.c_str()));
+      else if (arg == "--max-frames")
+        max_frames = std::atoi(value.c_str());
+      else if (arg == "--min-pixels")
+        min_pixels = std::atoi(value.c_str());
+      else if (arg == "--config")
+        params = qs::loadSegmenterParams(value);
+      else
+        throw std::invalid_argument("unknown option " + arg);
+    }
+    const YAML::Node camera = YAML::LoadFile(dir + "/scene.yaml")["camera"];
+    qs::CameraIntrinsics k;
+    k.fx = camera["fx"].as<double>();
+    k.fy = camera["fy"].as<double>();
+    k.cx = camera["cx"].as<double>();
+    k.cy = camera["cy"].as<double>();
+    std::map<int, std::string> classes;
+    for (const qs::MapFileQuadric& q : qs::readMapYaml(dir + "/quadrics_gt.yaml").quadrics)
+      classes[q.id] = q.quadric_class;
+    qs::SegmentationScore score(classes, min_pixels);
+    const qs::NormalEstimator normals{qs::NormalEstimator::Params()};
+    const qs::QuadricSegmenter segmenter(params);
+    std::ifstream list(dir + "/depth.txt");
+    if (!list)
+      throw std::runtime_error("cannot read " + dir + "/depth.txt");
+    int index = 0, used = 0;
+    for (std::string line; std::getline(list, line) && used < max_frames;) {
+      if (line.empty() || line[0] == '#')
+        continue;
+      if (index++ % stride != 0)
+        continue;
+      std::istringstream in(line);
+      std::string stamp, file;
+      in >> stamp >> file;
+      const cv::Mat depth = qs::readTumDepthPng(dir + "/" + file);
+      const std::string name = file.substr(file.find_last_of('/') + 1);
+      const cv::Mat truth = cv::imread(dir + "/labels/" + name, cv::IMREAD_ANYDEPTH);
+      if (truth.empty() || truth.type() != CV_16UC1)
+        throw std::runtime_error("cannot read the label image labels/" + name);
+      k.width = depth.cols;
+      k.height = depth.rows;
+      qs::DepthImageView<float> view;
+      view.data = depth.data;
+      view.width = depth.cols;
+      view.height = depth.rows;
+      view.row_step_bytes = depth.step[0];
+      const auto cloud = normals.compute(qs::backProject(view, k, qs::BackProjectionParams()));
+      const qs::Segmentation segmentation = segmenter.segment(cloud);
+      cv::Mat valid = depth == depth;  // not NaN
+      score.addFrame(segmentation, truth, valid);
+      ++used;
+    }
+    std::printf("%s", score.report().c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "eval_segmentation: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,163 @@
+// PrimitiveShape: the msg/QuadricSurface.msg pose/scale conventions checked against the quadric
+// equation (S p_Q)^T D(sigma) (S p_Q) + sigma_4 = 0 (eq. 5), round trips, distances, the minimal
+// perturbation; ShapeRefiner on exact and noisy samples.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <random>
+
+#include "quadric_slam/frontend/primitive_shape.h"
+#include "quadric_slam/frontend/shape_refiner.h"
+
+namespace qs = quadric_slam;
+using qs::PrimitiveShape;
+using qs::QuadricClass;
+
+namespace {
+
+std::vector<PrimitiveShape> someShapes() {
+  return {
+      PrimitiveShape::plane(Eigen::Vector3d(0.2, -0.9, -0.3), -1.1),
+      PrimitiveShape::sphere(Eigen::Vector3d(0.3, -0.2, 1.5), 0.17),
+      PrimitiveShape::cylinder(Eigen::Vector3d(0.1, 0.4, 1.8), Eigen::Vector3d(0.1, -1, 0.2), 0.06),
+      PrimitiveShape::cone(Eigen::Vector3d(-0.3, 0.1, 1.4), Eigen::Vector3d(0, 1, 0.3), 0.35)};
+}
+
+// Points exactly on the surface, in the shape's frame: built in the canonical quadric frame.
+std::vector<Eigen::Vector3d> surfaceSamples(const PrimitiveShape& s, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  const Eigen::Isometry3d T = s.poseInFrame();
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i) {
+    Eigen::Vector3d q;
+    const double a = M_PI * uni(rng) * 0.6, h = uni(rng);
+    switch (s.quadric_class) {
+      case QuadricClass::kPlane:
+        q = Eigen::Vector3d(0, 0.5 * h, 0.5 * uni(rng));
+        break;
+      case QuadricClass::kSphere: {
+        const double e = 0.6 * uni(rng);
+        q = s.size *
+            Eigen::Vector3d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+        break;
+      }
+      case QuadricClass::kCylinder:
+        q = Eigen::Vector3d(s.size * std::cos(a), s.size * std::sin(a), 0.2 * h);
+        break;
+      default: {
+        const double z = 0.3 + 0.2 * h;
+        const double r = z * std::tan(s.size);
+        q = Eigen::Vector3d(r * std::cos(a), r * std::sin(a), z);
+      }
+    }
+    points.push_back(T * q);
+  }
+  return points;
+}
+
+}  // namespace
+
+TEST(PrimitiveShape, PoseAndScaleSatisfyTheQuadricEquationOfTheMessageConvention) {
+  for (const PrimitiveShape& s : someShapes()) {
+    const Eigen::Isometry3d T_frame_quadric = s.poseInFrame();
+    const Eigen::Vector3d scale = s.scale();
+    const Eigen::Vector4d sigma = qs::defaultSignature(s.quadric_class);
+    for (const Eigen::Vector3d& p : surfaceSamples(s, 50, 3)) {
+      EXPECT_NEAR(s.distance(p), 0.0, 1e-9);
+      const Eigen::Vector3d sp = scale.asDiagonal() * (T_frame_quadric.inverse() * p);
+      const double value =
+          sigma[0] * sp[0] * sp[0] + sigma[1] * sp[1] * sp[1] + sigma[2] * sp[2] * sp[2] + sigma[3];
+      EXPECT_NEAR(value, 0.0, 1e-9) << qs::toString(s.quadric_class);
+    }
+    // A point off the surface does not satisfy it.
+    const Eigen::Vector3d off = s.poseInFrame() * Eigen::Vector3d(0.5, 0.4, 0.3);
+    EXPECT_GT(std::abs(s.distance(off)), 1e-3);
+  }
+  // Plane normal = quadric x axis; cylinder/cone axis = quadric z; cone apex = origin.
+  const auto shapes = someShapes();
+  EXPECT_NEAR((shapes[0].poseInFrame().linear().col(0) - shapes[0].direction).norm(), 0, 1e-12);
+  EXPECT_NEAR((shapes[2].poseInFrame().linear().col(2) - shapes[2].direction).norm(), 0, 1e-12);
+  EXPECT_NEAR((shapes[3].poseInFrame().translation() - shapes[3].point).norm(), 0, 1e-12);
+  EXPECT_NEAR(shapes[3].scale().x(), 1.0 / std::tan(0.35), 1e-12);
+  EXPECT_NEAR(shapes[2].scale().x(), 1.0 / 0.06, 1e-9);
+  EXPECT_DOUBLE_EQ(shapes[2].scale().z(), 1.0);
+}
+
+TEST(PrimitiveShape, FromPoseInvertsPoseAndScale) {
+  for (const PrimitiveShape& s : someShapes()) {
+    const PrimitiveShape back =
+        PrimitiveShape::fromPose(s.quadric_class, s.poseInFrame(), s.scale());
+    const std::vector<double> a = s.shapeVector(), b = back.shapeVector();
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i)
+      EXPECT_NEAR(a[i], b[i], 1e-9);
+  }
+}
+
+TEST(PrimitiveShape, PerturbationHasTheTableTwoDimensionAndMovesTheSurface) {
+  for (const PrimitiveShape& s : someShapes()) {
+    const int k = qs::minimalDimension(s.quadric_class);
+    EXPECT_EQ(static_cast<int>(qs::minimalIndices(s.quadric_class).size()), k);
+    const PrimitiveShape same = qs::perturb(s, Eigen::VectorXd::Zero(k));
+    const Eigen::Vector3d probe = s.poseInFrame() * Eigen::Vector3d(0.3, 0.2, 0.4);
+    EXPECT_NEAR(same.distance(probe), s.distance(probe), 1e-12);
+    // Every minimal direction changes the surface (no gauge direction in the minimal set).
+    const std::vector<Eigen::Vector3d> samples = surfaceSamples(s, 200, 5);
+    for (int j = 0; j < k; ++j) {
+      Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
+      delta[j] = 1e-3;
+      EXPECT_GT(qs::rmsDistance(qs::perturb(s, delta), samples), 1e-6)
+          << qs::toString(s.quadric_class) << " coordinate " << j;
+    }
+  }
+  EXPECT_THROW(qs::perturb(someShapes()[0], Eigen::VectorXd::Zero(4)), std::invalid_argument);
+}
+
+TEST(ShapeRefiner, RecoversEachClassFromAPerturbedStartAndScalesCovarianceWithNoise) {
+  const qs::ShapeRefiner refiner;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (const PrimitiveShape& truth : someShapes()) {
+    const int k = qs::minimalDimension(truth.quadric_class);
+    std::vector<Eigen::Vector3d> points = surfaceSamples(truth, 1500, 9);
+    Eigen::VectorXd delta(k);
+    for (int j = 0; j < k; ++j)
+      delta[j] = 0.01 * ((j % 2) ? 1 : -1);
+    const PrimitiveShape start = qs::perturb(truth, delta);
+    const qs::ShapeRefiner::Result exact = refiner.refine(start, points);
+    EXPECT_LT(exact.rms, 1e-6) << qs::toString(truth.quadric_class);
+    const std::vector<double> a = truth.shapeVector(), b = exact.shape.shapeVector();
+    // The same surface: the exact samples lie on it (cylinder/cone axis points are free).
+    EXPECT_LT(qs::rmsDistance(exact.shape, surfaceSamples(truth, 300, 21)), 1e-6);
+    if (truth.quadric_class == QuadricClass::kSphere ||
+        truth.quadric_class == QuadricClass::kPlane) {
+      for (std::size_t i = 0; i < a.size(); ++i)
+        EXPECT_NEAR(a[i], b[i], 1e-5) << qs::toString(truth.quadric_class) << " entry " << i;
+    } else {
+      EXPECT_NEAR(a.back(), b.back(), 1e-6);  // radius / half angle
+    }
+
+    // With 2 mm noise the RMS is ~2 mm and the covariance is positive definite and small.
+    for (auto& p : points)
+      p += 0.002 * Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)) / std::sqrt(3.0);
+    const qs::ShapeRefiner::Result noisy = refiner.refine(start, points);
+    EXPECT_TRUE(noisy.ok);
+    EXPECT_NEAR(noisy.rms, 0.002 / std::sqrt(3.0), 0.0005);
+    ASSERT_EQ(noisy.covariance.rows(), k);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(noisy.covariance);
+    EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
+  }
+}
+
+TEST(ShapeRefiner, ParamsValidateNamesTheField) {
+  qs::ShapeRefiner::Params p;
+  p.max_iterations = 0;
+  try {
+    p.validate();
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("max_iterations"), std::string::npos);
+  }
+}
