@@ -1,5 +1,6 @@
 // run_bag: the offline runner. Pushes every frame of a TUM rosbag or TUM folder through the same
-// core classes the nodelets use (back-projection + normals, odometry), as fast as the machine
+// core classes the nodelets use (back-projection + normals, quadric segmentation, odometry), with
+// the same config/*.yaml parameters, as fast as the machine
 // allows: no master, no real-time pacing. Writes DIR/trajectory.txt (TUM format, camera optical
 // frame in the odom frame) and DIR/timing.json (per-stage median/p95/max); with --gt prints the
 // ATE and RPE.
@@ -12,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -20,6 +22,8 @@
 #include "quadric_slam/eval/trajectory_metrics.h"
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/frontend/quadric_segmenter.h"
+#include "quadric_slam/frontend/segmenter_params.h"
 #include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/io/pipeline_params.h"
 #include "quadric_slam/io/trajectory_io.h"
@@ -149,7 +153,10 @@ int main(int argc, char** argv) {
                                    normal_params, log);
     qs::OdometryTracker::Params odometry_params;
     qs::readOdometryParams(configFile(o, "odometry.yaml"), odometry_params, log);
+    qs::QuadricSegmenter::Params segmenter_params;
+    qs::readSegmentationParams(configFile(o, "segmentation.yaml"), segmenter_params, log);
     const qs::NormalEstimator normals(normal_params);
+    const qs::QuadricSegmenter segmenter(segmenter_params);
     qs::OdometryTracker odometry(odometry_params);
 
     std::unique_ptr<qs::FrameSource> source = openInput(o);
@@ -164,6 +171,7 @@ int main(int argc, char** argv) {
     qs::StageTimer timer;
     qs::Trajectory trajectory;
     int status_counts[3] = {0, 0, 0};
+    std::map<std::string, std::size_t> observations_per_class;
     std::size_t frames = 0, skipped = 0;
     double last_stamp = -1e300;
     const auto start = std::chrono::steady_clock::now();
@@ -187,6 +195,12 @@ int main(int argc, char** argv) {
       const pcl::PointCloud<pcl::PointNormal> cloud = timer.time("normals", [&] {
         return normals.compute(qs::backProject(qs::depthViewOf(frame.depth_m), k, back_projection));
       });
+      if (!o.odometry_only) {
+        const qs::Segmentation segmentation =
+            timer.time("segmentation", [&] { return segmenter.segment(cloud); });
+        for (const qs::QuadricDetection& detection : segmentation.detections)
+          ++observations_per_class[qs::toString(detection.shape.quadric_class)];
+      }
       const qs::OdometryTracker::Result result =
           timer.time("odometry", [&] { return odometry.track(cloud, k, frame.stamp); });
       ++status_counts[static_cast<int>(result.status)];
@@ -212,6 +226,13 @@ int main(int argc, char** argv) {
                 frames / std::max(wall_s, 1e-9));
     std::printf("tracking ok %d degenerate %d lost %d\n", status_counts[0], status_counts[1],
                 status_counts[2]);
+    if (!o.odometry_only) {
+      std::printf("observations per frame:");
+      for (const auto& [name, count] : observations_per_class)
+        std::printf(" %s %.2f", name.c_str(),
+                    static_cast<double>(count) / std::max<std::size_t>(frames, 1));
+      std::printf("\n");
+    }
     std::fputs(timer.table().c_str(), stdout);
     std::printf("trajectory %s/trajectory.txt\ntiming %s/timing.json\n", o.out_dir.c_str(),
                 o.out_dir.c_str());

@@ -4,6 +4,7 @@
 // error against the ground truth.
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
+#include <quadric_slam/QuadricObservationArray.h>
 #include <ros/ros.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -14,6 +15,7 @@
 
 #include <filesystem>
 #include <map>
+#include <set>
 
 #include "quadric_slam/eval/trajectory_metrics.h"
 #include "quadric_slam/io/scene.h"
@@ -54,7 +56,7 @@ class PipelineTest : public ::testing::Test {
   qs::Trajectory truth_;
 };
 
-TEST_F(PipelineTest, EveryFrameGivesNormalsAndOdometryThatFollowsTheTruth) {
+TEST_F(PipelineTest, EveryFrameGivesNormalsObservationsAndOdometryThatFollowsTheTruth) {
   ros::NodeHandle nh;
   ros::Publisher depth_pub = nh.advertise<sensor_msgs::Image>("/camera/depth/image", 2);
   ros::Publisher info_pub =
@@ -67,13 +69,19 @@ TEST_F(PipelineTest, EveryFrameGivesNormalsAndOdometryThatFollowsTheTruth) {
   ros::Subscriber cloud_sub = nh.subscribe<sensor_msgs::PointCloud2>(
       "points_normals", 100,
       [&](const sensor_msgs::PointCloud2ConstPtr& m) { clouds[m->header.stamp.toSec()] = m; });
+  std::map<double, quadric_slam::QuadricObservationArrayConstPtr> observations;
+  ros::Subscriber observations_sub = nh.subscribe<quadric_slam::QuadricObservationArray>(
+      "observations", 100, [&](const quadric_slam::QuadricObservationArrayConstPtr& m) {
+        observations[m->header.stamp.toSec()] = m;
+      });
   tf2_ros::Buffer tf_buffer;
   tf2_ros::TransformListener tf_listener(tf_buffer);
 
   const ros::WallTime connect_deadline = ros::WallTime::now() + ros::WallDuration(60.0);
   // One connection per subscribing process: both nodelets share the manager's.
   while ((depth_pub.getNumSubscribers() == 0 || info_pub.getNumSubscribers() == 0 ||
-          odom_sub.getNumPublishers() == 0 || cloud_sub.getNumPublishers() == 0) &&
+          odom_sub.getNumPublishers() == 0 || cloud_sub.getNumPublishers() == 0 ||
+          observations_sub.getNumPublishers() == 0) &&
          ros::WallTime::now() < connect_deadline) {
     ros::WallDuration(0.05).sleep();
     ros::spinOnce();
@@ -106,13 +114,15 @@ TEST_F(PipelineTest, EveryFrameGivesNormalsAndOdometryThatFollowsTheTruth) {
     for (int attempt = 0; attempt < 3 && !odoms.count(stamp); ++attempt) {
       depth_pub.publish(depth);
       const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(20.0);
-      while (!odoms.count(stamp) && ros::WallTime::now() < deadline &&
+      while ((!odoms.count(stamp) || !observations.count(stamp)) &&
+             ros::WallTime::now() < deadline &&
              (published > 0 || ros::WallTime::now() < deadline - ros::WallDuration(17.0))) {
         ros::WallDuration(0.005).sleep();
         ros::spinOnce();
       }
     }
     ++published;
+    ASSERT_TRUE(observations.count(stamp)) << "no observations for frame " << published;
     ASSERT_TRUE(odoms.count(stamp)) << "no odom for frame " << published << " at " << stamp;
   }
   ros::WallDuration(0.2).sleep();
@@ -129,6 +139,32 @@ TEST_F(PipelineTest, EveryFrameGivesNormalsAndOdometryThatFollowsTheTruth) {
   EXPECT_EQ(cloud.width, 640u);
   EXPECT_EQ(cloud.height, 480u);
   EXPECT_TRUE(tf_buffer.canTransform("odom", "camera", ros::Time(0), ros::Duration(2.0)));
+
+  // The desk scene seen from the hand-held path holds planes (walls, desk), the globe (sphere),
+  // the poster tube (cylinder) and the lamp shade (cone): each class must be observed in most
+  // frames, in the camera frame, with a covariance of its class's minimal dimension.
+  EXPECT_EQ(observations.size(), truth_.size());
+  std::map<int, int> frames_with_class;
+  for (const auto& [stamp, array] : observations) {
+    EXPECT_EQ(array->header.frame_id, "/openni_rgb_optical_frame");
+    std::set<int> classes;
+    for (const auto& o : array->observations) {
+      classes.insert(o.surface.quadric_class);
+      EXPECT_EQ(o.covariance.size(),
+                static_cast<std::size_t>(o.minimal_dimension) * o.minimal_dimension);
+      EXPECT_GT(o.num_points, 0u);
+    }
+    for (int c : classes)
+      ++frames_with_class[c];
+  }
+  const int frames = static_cast<int>(truth_.size());
+  EXPECT_GE(frames_with_class[quadric_slam::QuadricSurface::CLASS_PLANE], frames);
+  EXPECT_GE(frames_with_class[quadric_slam::QuadricSurface::CLASS_SPHERE], 0.9 * frames);
+  EXPECT_GE(frames_with_class[quadric_slam::QuadricSurface::CLASS_CYLINDER], 0.9 * frames);
+  EXPECT_GE(frames_with_class[quadric_slam::QuadricSurface::CLASS_CONE], 0.5 * frames);
+  std::printf("pipeline: frames with plane %d, sphere %d, cylinder %d, cone %d of %d\n",
+              frames_with_class[0], frames_with_class[1], frames_with_class[2],
+              frames_with_class[3], frames);
 
   // The odometry against the ground truth (TUM conventions: rigid alignment, ATE RMSE).
   qs::Trajectory estimate;
