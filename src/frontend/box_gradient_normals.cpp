@@ -84,8 +84,9 @@ struct IntegralImages {
     const double count = d.n - b.n - c.n + a.n;
     if (count < min_fraction * (u1 - u0 + 1) * (v1 - v0 + 1) || count < 1.0)
       return false;
-    out = Eigen::Vector3d(d.x - b.x - c.x + a.x, d.y - b.y - c.y + a.y, d.z - b.z - c.z + a.z) /
-          count;
+    const double inverse_count = 1.0 / count;  // one division, not three
+    out = Eigen::Vector3d(d.x - b.x - c.x + a.x, d.y - b.y - c.y + a.y, d.z - b.z - c.z + a.z) *
+          inverse_count;
     return true;
   }
 };
