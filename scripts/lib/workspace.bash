@@ -24,3 +24,18 @@ qs_source() {
   source "$QS_WS/devel/setup.bash"
   set -u
 }
+
+# Runs one of the package's tools (.ws/devel/lib/quadric_slam/NAME) with the remaining arguments,
+# building the workspace first when the binary is missing.
+qs_exec_tool() {
+  local name=$1
+  shift
+  local binary="$QS_WS/devel/lib/quadric_slam/$name"
+  if [ ! -x "$binary" ]; then
+    echo "$name: building the workspace in $QS_WS (first use)" >&2
+    "$QS_ROOT/scripts/setup" >&2
+    qs_build >&2
+  fi
+  qs_source
+  exec "$binary" "$@"
+}

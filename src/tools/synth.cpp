@@ -58,17 +58,9 @@ struct Options {
   std::vector<std::pair<std::string, double>> camera_overrides;
 };
 
+// The package's desk scene (CMake passes the config folder).
 std::string defaultScene() {
-  const std::string relative = "config/scenes/desk.yaml";
-  if (std::filesystem::exists(relative))
-    return relative;
-  // The package source is the parent of ../shared/data (set by CMake).
-  std::string data = QUADRIC_SLAM_SHARED_DATA_DIR;
-  const std::string suffix = "/../shared/data";
-  if (data.size() > suffix.size() &&
-      data.compare(data.size() - suffix.size(), suffix.size(), suffix) == 0)
-    return data.substr(0, data.size() - suffix.size()) + "/" + relative;
-  return relative;
+  return std::string(QUADRIC_SLAM_CONFIG_DIR) + "/scenes/desk.yaml";
 }
 
 Options parse(int argc, char** argv) {
