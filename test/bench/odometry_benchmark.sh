@@ -4,7 +4,8 @@
 #
 #   test/bench/odometry_benchmark.sh [--out DIR] [--seconds S] [--sequences "fr1_desk fr1_xyz"]
 #                                    [--methods "legacy_hybrid t_point_to_plane ..."]
-#                                    [--max-frames N] [--regenerate] [--no-open3d]
+#                                    [--max-frames N] [--open3d-max-frames N] [--regenerate]
+#                                    [--no-open3d]
 #
 #   --out DIR       where sequences and results go (default out/bench, ignored by git)
 #   --seconds S     sequence length given to scripts/synth (default 40: longer than both trajectories,
@@ -13,6 +14,9 @@
 #                   fr2_desk fr2_xyz; default "fr1_desk fr1_xyz")
 #   --methods       Open3D methods (see test/bench/open3d_odometry.py; default all three)
 #   --max-frames N  only the first N frames of each sequence (quick runs; default all)
+#   --open3d-max-frames N
+#                   Open3D only on the first N frames (it runs at 0.2-1.5 s per frame single-threaded
+#                   here); ours then also runs on those N frames, as an extra like-for-like row
 #   --regenerate    re-render sequences that already exist
 #   --no-open3d     only our pipeline
 #
@@ -31,6 +35,7 @@ seconds=40
 sequences="fr1_desk fr1_xyz"
 methods="legacy_hybrid t_point_to_plane icp_point_to_plane"
 max_frames=0
+o3d_max_frames=0
 regenerate=0
 open3d=1
 while [ $# -gt 0 ]; do
@@ -40,9 +45,10 @@ while [ $# -gt 0 ]; do
     --sequences) sequences=$2; shift 2 ;;
     --methods) methods=$2; shift 2 ;;
     --max-frames) max_frames=$2; shift 2 ;;
+    --open3d-max-frames) o3d_max_frames=$2; shift 2 ;;
     --regenerate) regenerate=1; shift ;;
     --no-open3d) open3d=0; shift ;;
-    -h|--help) sed -n '2,26p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,30p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "odometry_benchmark: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -106,7 +112,7 @@ for seq in $sequences; do
     rm -rf "$dir"
     echo "== $seq: rendering $seconds s along $(basename "$gt_file")" >&2
     "$QS_ROOT/scripts/synth" --out "$dir" --trajectory "$gt_file" --seconds "$seconds" \
-      --no-bag --no-labels --name "$seq" >"$out/$seq.synth.log" 2>&1
+      --no-bag --no-labels --name "$seq" --threads "$QS_JOBS" >"$out/$seq.synth.log" 2>&1
   fi
   n=$(grep -vc '^#' "$dir/depth.txt")
   echo "== $seq: $n frames" >&2
@@ -120,16 +126,27 @@ for seq in $sequences; do
   evaluate_row "$seq" ours "$dir/ours/trajectory.txt" "$dir/ours/timing.json" ours
 
   [ "$open3d" -eq 1 ] || continue
+  o3d_frames=$max_frames
+  if [ "$o3d_max_frames" -gt 0 ] && { [ "$max_frames" -eq 0 ] || [ "$o3d_max_frames" -lt "$max_frames" ]; }; then
+    o3d_frames=$o3d_max_frames
+    echo "== $seq: ours on the first $o3d_frames frames (like for like with Open3D)" >&2
+    mkdir -p "$dir/ours_first$o3d_frames"
+    "$QS_ROOT/scripts/run_bag" "$dir" --out "$dir/ours_first$o3d_frames" --odometry-only \
+      --max-frames "$o3d_frames" >"$dir/ours_first$o3d_frames/run_bag.log" 2>&1 ||
+      { cat "$dir/ours_first$o3d_frames/run_bag.log" >&2; exit 1; }
+    evaluate_row "$seq" "ours (first $o3d_frames frames)" "$dir/ours_first$o3d_frames/trajectory.txt" \
+      "$dir/ours_first$o3d_frames/timing.json" ours
+  fi
   for method in $methods; do
     echo "== $seq: open3d $method" >&2
     mkdir -p "$dir/open3d"
     # Direction check first: the chained motions must match groundtruth.txt, not its inverse.
-    "$py" "$o3d_script" --seq "$dir" --method "$method" --out /dev/null --check-direction 5 \
+    "$py" "$o3d_script" --seq "$dir" --method "$method" --out /dev/null --check-direction 10 \
       >"$dir/open3d/$method.check.log" 2>&1 || { cat "$dir/open3d/$method.check.log" >&2; exit 1; }
     tail -n 1 "$dir/open3d/$method.check.log" >&2
     o3d_args=(--seq "$dir" --method "$method" --out "$dir/open3d/$method.txt"
               --timing "$dir/open3d/$method.timing.json")
-    [ "$max_frames" -gt 0 ] && o3d_args+=(--max-frames "$max_frames")
+    [ "$o3d_frames" -gt 0 ] && o3d_args+=(--max-frames "$o3d_frames")
     "$py" "$o3d_script" "${o3d_args[@]}" >&2
     evaluate_row "$seq" "open3d $method" "$dir/open3d/$method.txt" \
       "$dir/open3d/$method.timing.json" open3d
