@@ -23,7 +23,8 @@ class OdometryTracker {
     // ... or turned more than this (rad). (0, pi]
     double keyframe_rotation = 0.1745;
     // ... or when the inlier fraction (overlap with the keyframe) drops below this. [0, 1]
-    double keyframe_min_overlap = 0.5;
+    // (0.7: fresher keyframes over weakly constrained views; see config/odometry.yaml)
+    double keyframe_min_overlap = 0.7;
     // Predict each frame with the last inter-frame motion (scaled by the time step) instead of the
     // last pose.
     bool constant_velocity = true;
