@@ -142,10 +142,16 @@ void computeBoxGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   // Each half of the box must be at least half full for its mean to be trusted.
   constexpr double kMinFraction = 0.5;
 
-  auto process_rows = [&](int v_begin, int v_end) {
-    for (int v = v_begin; v < v_end; ++v) {
+  // A normal is estimated at every stride-th pixel in u and v and given to the valid pixels of its
+  // stride x stride block that are not on an edge and do not differ from it in depth by more than
+  // the edge threshold: the smoothing window (10 px) is much wider than a block, so neighbouring
+  // normals differ little, and the work drops by stride^2.
+  const int stride = std::max(1, settings.stride);
+  const auto factor = static_cast<float>(settings.max_depth_change_factor);
+  auto process_block_rows = [&](int block_begin, int block_end) {
+    for (int v = block_begin * stride; v < std::min(height, block_end * stride); v += stride) {
       const float* dist_row = distance.ptr<float>(v);
-      for (int u = 0; u < width; ++u) {
+      for (int u = 0; u < width; u += stride) {
         const pcl::PointXYZ& p = cloud(u, v);
         if (!std::isfinite(p.z))
           continue;
@@ -171,19 +177,26 @@ void computeBoxGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
         const double norm = normal.norm();
         if (!(norm > 0.0))
           continue;
-        normal /= norm;
-        // Face the sensor at the origin.
-        if (normal.dot(Eigen::Vector3d(p.x, p.y, p.z)) > 0.0)
-          normal = -normal;
-        pcl::PointNormal& q = out(u, v);
-        q.normal_x = static_cast<float>(normal.x());
-        q.normal_y = static_cast<float>(normal.y());
-        q.normal_z = static_cast<float>(normal.z());
+        const Eigen::Vector3f n = (normal / norm).cast<float>();
+        for (int bv = v; bv < std::min(height, v + stride); ++bv) {
+          const float* block_dist = distance.ptr<float>(bv);
+          for (int bu = u; bu < std::min(width, u + stride); ++bu) {
+            pcl::PointNormal& q = out(bu, bv);
+            if (!std::isfinite(q.z) || std::abs(q.z - p.z) > factor * p.z ||
+                (block_dist[bu] < 1.0f && (bu != u || bv != v)))
+              continue;
+            // Face the sensor at the origin.
+            const float sign = n.x() * q.x + n.y() * q.y + n.z() * q.z > 0.f ? -1.f : 1.f;
+            q.normal_x = sign * n.x();
+            q.normal_y = sign * n.y();
+            q.normal_z = sign * n.z();
+          }
+        }
       }
     }
   };
 
-  forEachChunk(height, settings.threads, process_rows);
+  forEachChunk((height + stride - 1) / stride, settings.threads, process_block_rows);
 }
 
 }  // namespace quadric_slam

@@ -43,6 +43,10 @@ void NormalEstimator::Params::validate() const {
     throw std::invalid_argument("normal_smoothing_size must be in [1, 100] pixels, got " +
                                 std::to_string(normal_smoothing_size));
   }
+  if (normal_stride < 1 || normal_stride > 4) {
+    throw std::invalid_argument("normal_stride must be in [1, 4], got " +
+                                std::to_string(normal_stride));
+  }
   if (threads < 1 || threads > 64) {
     throw std::invalid_argument("threads must be in [1, 64], got " + std::to_string(threads));
   }
@@ -73,6 +77,7 @@ pcl::PointCloud<pcl::PointNormal> NormalEstimator::compute(
     settings.max_depth_change_factor = params_.max_depth_change_factor;
     settings.depth_dependent_smoothing = params_.depth_dependent_smoothing;
     settings.threads = params_.threads;
+    settings.stride = params_.normal_stride;
     computeBoxGradientNormals(cloud, settings, out);
     return out;
   }

@@ -12,6 +12,7 @@ void readNormalEstimationParams(const ParamReader& reader, BackProjectionParams&
   readParam(reader, "normal_smoothing_size", normals.normal_smoothing_size, log);
   readParam(reader, "depth_dependent_smoothing", normals.depth_dependent_smoothing, log);
   readParam(reader, "threads", normals.threads, log);
+  readParam(reader, "normal_stride", normals.normal_stride, log);
   back_projection.validate();
   normals.validate();
 }

@@ -15,6 +15,7 @@ struct BoxGradientSettings {
   bool depth_dependent_smoothing =
       true;         // shrink the window for near points (half-window * z / 2 m)
   int threads = 2;  // worker threads over image rows
+  int stride = 1;  // estimate at every stride-th pixel in u and v, share within its block
 };
 
 // Writes normals (facing the sensor origin) and curvature (NaN: not estimated by this method) into

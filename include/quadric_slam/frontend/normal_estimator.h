@@ -26,6 +26,10 @@ class NormalEstimator {
     bool depth_dependent_smoothing = true;
     // Worker threads of box_gradient (PCL's methods are single-threaded).
     int threads = 2;
+    // box_gradient estimates a normal at every normal_stride-th pixel in u and v and shares it
+    // with its block (not across edges): stride^2 less work, blocks far smaller than the
+    // smoothing window. 1 = every pixel. [1, 4]
+    int normal_stride = 2;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
