@@ -113,7 +113,13 @@ ShapeRefiner::Result ShapeRefiner::refine(const PrimitiveShape& initial,
       const Eigen::VectorXd delta = A.ldlt().solve(-g);
       if (!delta.allFinite())
         break;
-      const PrimitiveShape candidate = perturb(shape, delta);
+      PrimitiveShape candidate;
+      try {
+        candidate = perturb(shape, delta);
+      } catch (const std::invalid_argument&) {  // step left the class (e.g. negative scale)
+        lambda *= 10;
+        continue;
+      }
       const Eigen::VectorXd r_new = residuals(candidate, points);
       const double cost_new = r_new.squaredNorm();
       if (std::isfinite(cost_new) && cost_new < cost) {
