@@ -1,5 +1,6 @@
 #include "quadric_slam/frontend/quadric_segmenter.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -221,6 +222,50 @@ PrimitiveShape coneFromCylinder(const PrimitiveShape& cylinder,
   cone.point = cylinder.point - (r0 / k) * d;
   cone.direction = k > 0 ? d : Eigen::Vector3d(-d);
   cone.size = std::atan(std::abs(k));
+  return cone;
+}
+
+// A cone from points and their normals: every tangent plane passes through the apex
+// (n_i . (apex - p_i) = 0, linear least squares), and the normals lie on a small circle around
+// the axis (the least-variance direction of the centred normals). Catches the side view of a cone,
+// whose visible strip a tilted cylinder also fits. Half angle 0 when degenerate.
+PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
+                               const std::vector<Eigen::Vector3d>& normals) {
+  PrimitiveShape cone = PrimitiveShape::cone(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0);
+  if (points.size() < 10 || points.size() != normals.size())
+    return cone;
+  Eigen::Vector3d mean_n = Eigen::Vector3d::Zero();
+  for (const auto& n : normals)
+    mean_n += n;
+  mean_n /= static_cast<double>(normals.size());
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero(), A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    C += (normals[i] - mean_n) * (normals[i] - mean_n).transpose();
+    A += normals[i] * normals[i].transpose();
+    b += normals[i] * normals[i].dot(points[i]);
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig_a(A);
+  if (eig.info() != Eigen::Success || eig_a.info() != Eigen::Success ||
+      eig_a.eigenvalues()[0] < 1e-6 * eig_a.eigenvalues()[2])
+    return cone;
+  Eigen::Vector3d axis = eig.eigenvectors().col(0);
+  const Eigen::Vector3d apex = A.ldlt().solve(b);
+  double mean_z = 0;
+  for (const auto& q : points)
+    mean_z += axis.dot(q - apex);
+  if (mean_z < 0)
+    axis = -axis;
+  double angle = 0;
+  for (const auto& q : points) {
+    const Eigen::Vector3d v = q - apex;
+    const double z = axis.dot(v);
+    angle += std::atan2((v - z * axis).norm(), z);
+  }
+  cone.point = apex;
+  cone.direction = axis;
+  cone.size = angle / static_cast<double>(points.size());
   return cone;
 }
 
@@ -468,10 +513,18 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
           fit = as_cylinder;
       }
       if (fit.shape.quadric_class == QuadricClass::kCylinder && p.detect_cones) {
-        const PrimitiveShape start = coneFromCylinder(fit.shape, points);
-        if (plausible(start, p)) {
+        std::vector<Eigen::Vector3d> normals;
+        normals.reserve(indices.size());
+        for (int i : indices)
+          normals.push_back(normalOf(cloud.points[i]).normalized());
+        const ShapeRefiner::Result cylinder = fit;
+        for (const PrimitiveShape& start :
+             {coneFromCylinder(cylinder.shape, points), coneFromNormals(points, normals)}) {
+          if (!plausible(start, p))
+            continue;
           const ShapeRefiner::Result as_cone = refiner.refine(start, points);
-          if (p.cylinder_rms_ratio * as_cone.rms < fit.rms && plausible(as_cone.shape, p))
+          if (p.cylinder_rms_ratio * as_cone.rms < cylinder.rms && as_cone.rms < fit.rms &&
+              plausible(as_cone.shape, p))
             fit = as_cone;
         }
       }
