@@ -26,6 +26,17 @@ ShapeRefiner::ShapeRefiner(const Params& params) : params_(params) {
 
 namespace {
 
+// Whether the shape has a core quadric (finite, radius > 0, cone half angle in (0, pi/2)), which
+// the perturbation needs; e.g. a RANSAC cone may come with a half angle beyond pi/2.
+bool validShape(const PrimitiveShape& shape) {
+  try {
+    shape.quadric();
+    return true;
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+}
+
 Eigen::VectorXd residuals(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
   Eigen::VectorXd r(points.size());
   for (std::size_t i = 0; i < points.size(); ++i)
@@ -93,7 +104,7 @@ ShapeRefiner::Result ShapeRefiner::refine(const PrimitiveShape& initial,
   Result result;
   result.shape = initial;
   const int k = minimalDimension(initial.quadric_class);
-  if (static_cast<int>(all_points.size()) <= k)
+  if (static_cast<int>(all_points.size()) <= k || !validShape(initial))
     return result;
 
   const std::vector<Eigen::Vector3d> points = subsample(all_points, params_.max_points);
@@ -146,7 +157,8 @@ ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
                                             const std::vector<Eigen::Vector3d>& all_points) const {
   Result result;
   result.shape = shape;
-  if (static_cast<int>(all_points.size()) <= minimalDimension(shape.quadric_class))
+  if (static_cast<int>(all_points.size()) <= minimalDimension(shape.quadric_class) ||
+      !validShape(shape))
     return result;
   return covarianceOf(shape, subsample(all_points, params_.max_points), all_points.size());
 }

@@ -188,3 +188,16 @@ TEST(ShapeRefiner, ParamsValidateNamesTheField) {
     EXPECT_NE(std::string(e.what()).find("max_iterations"), std::string::npos);
   }
 }
+
+TEST(ShapeRefiner, AShapeWithoutACoreQuadricIsNotRefinedAndDoesNotThrow) {
+  // A RANSAC cone may come with a half angle beyond pi/2: no quadric, no perturbation.
+  const PrimitiveShape bad =
+      PrimitiveShape::cone(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, 1), 2.2);
+  EXPECT_THROW(bad.quadric(), std::invalid_argument);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 50; ++i)
+    points.emplace_back(0.01 * i, 0.02 * (i % 7), 1.5);
+  const qs::ShapeRefiner refiner;
+  EXPECT_FALSE(refiner.refine(bad, points).ok);
+  EXPECT_FALSE(refiner.evaluate(bad, points).ok);
+}
