@@ -101,6 +101,17 @@ ShapeRefiner::Result covarianceOf(const PrimitiveShape& shape,
 
 ShapeRefiner::Result ShapeRefiner::refine(const PrimitiveShape& initial,
                                           const std::vector<Eigen::Vector3d>& all_points) const {
+  try {
+    return refineUnchecked(initial, all_points);
+  } catch (const std::invalid_argument&) {  // a shape left its class (no core quadric)
+    Result result;
+    result.shape = initial;
+    return result;
+  }
+}
+
+ShapeRefiner::Result ShapeRefiner::refineUnchecked(
+    const PrimitiveShape& initial, const std::vector<Eigen::Vector3d>& all_points) const {
   Result result;
   result.shape = initial;
   const int k = minimalDimension(initial.quadric_class);
@@ -160,7 +171,11 @@ ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
   if (static_cast<int>(all_points.size()) <= minimalDimension(shape.quadric_class) ||
       !validShape(shape))
     return result;
-  return covarianceOf(shape, subsample(all_points, params_.max_points), all_points.size());
+  try {
+    return covarianceOf(shape, subsample(all_points, params_.max_points), all_points.size());
+  } catch (const std::invalid_argument&) {
+    return result;
+  }
 }
 
 PrimitiveShape fitPlane(const std::vector<Eigen::Vector3d>& points) {
