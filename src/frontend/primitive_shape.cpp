@@ -3,25 +3,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "quadric_slam/geometry/shapes.h"
+
 namespace quadric_slam {
-
-namespace {
-
-// Completes a unit vector to a right-handed rotation whose column `axis` is the vector.
-Eigen::Matrix3d frameWithAxis(const Eigen::Vector3d& unit, int axis) {
-  const Eigen::Vector3d a = unit.normalized();
-  const Eigen::Vector3d b = a.unitOrthogonal();
-  const Eigen::Vector3d c = a.cross(b);
-  Eigen::Matrix3d R;
-  if (axis == 0) {
-    R << a, b, c;
-  } else {  // axis == 2: columns (b, c, a) are right-handed since b x c = a
-    R << b, c, a;
-  }
-  return R;
-}
-
-}  // namespace
 
 PrimitiveShape PrimitiveShape::plane(const Eigen::Vector3d& normal, double offset) {
   PrimitiveShape s;
@@ -92,51 +76,42 @@ std::map<std::string, std::vector<double>> PrimitiveShape::schemaShape() const {
   }
 }
 
-Eigen::Isometry3d PrimitiveShape::poseInFrame() const {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.translation() = point;
-  if (quadric_class == QuadricClass::kPlane) {
-    T.linear() = frameWithAxis(direction, 0);
-  } else if (quadric_class == QuadricClass::kCylinder || quadric_class == QuadricClass::kCone) {
-    T.linear() = frameWithAxis(direction, 2);
-  }
-  return T;
-}
-
-Eigen::Vector3d PrimitiveShape::scale() const {
+QuadricModel PrimitiveShape::quadric() const {
   switch (quadric_class) {
+    case QuadricClass::kPlane:
+      return quadricFromShape(PlaneShape{direction, planeOffset()});
     case QuadricClass::kSphere:
-      return Eigen::Vector3d::Constant(1.0 / size);
+      return quadricFromShape(SphereShape{point, size});
     case QuadricClass::kCylinder:
-      return Eigen::Vector3d(1.0 / size, 1.0 / size, 1.0);
-    case QuadricClass::kCone: {
-      const double a = 1.0 / std::tan(size);
-      return Eigen::Vector3d(a, a, 1.0);
-    }
-    default:
-      return Eigen::Vector3d::Ones();
-  }
-}
-
-PrimitiveShape PrimitiveShape::fromPose(QuadricClass quadric_class,
-                                        const Eigen::Isometry3d& T_frame_quadric,
-                                        const Eigen::Vector3d& scale) {
-  const Eigen::Vector3d t = T_frame_quadric.translation();
-  const Eigen::Matrix3d R = T_frame_quadric.linear();
-  switch (quadric_class) {
-    case QuadricClass::kPlane: {
-      PrimitiveShape s;
-      s.quadric_class = QuadricClass::kPlane;
-      s.direction = R.col(0).normalized();
-      s.point = t;
-      return s;
-    }
-    case QuadricClass::kSphere:
-      return sphere(t, 1.0 / scale.x());
-    case QuadricClass::kCylinder:
-      return cylinder(t, R.col(2), 1.0 / scale.x());
+      return quadricFromShape(CylinderShape{point, direction, size});
     case QuadricClass::kCone:
-      return cone(t, R.col(2), std::atan(1.0 / scale.x()));
+      return quadricFromShape(ConeShape{point, direction, size});
+    default:
+      throw std::invalid_argument("PrimitiveShape: class general has no primitive shape");
+  }
+}
+
+PrimitiveShape PrimitiveShape::fromQuadric(const QuadricModel& q) {
+  switch (q.quadricClass()) {
+    case QuadricClass::kPlane: {
+      const PlaneShape s = planeShape(q);
+      // Keep the quadric origin as the plane point (it lies on the plane).
+      PrimitiveShape p = plane(s.normal, s.offset);
+      p.point = q.pose().translation();
+      return p;
+    }
+    case QuadricClass::kSphere: {
+      const SphereShape s = sphereShape(q);
+      return sphere(s.center, s.radius);
+    }
+    case QuadricClass::kCylinder: {
+      const CylinderShape s = cylinderShape(q);
+      return cylinder(s.point, s.axis, s.radius);
+    }
+    case QuadricClass::kCone: {
+      const ConeShape s = coneShape(q);
+      return cone(s.apex, s.axis, s.half_angle);
+    }
     default:
       throw std::invalid_argument("PrimitiveShape: class general has no primitive shape");
   }
@@ -212,21 +187,8 @@ PrimitiveShape perturb(const PrimitiveShape& shape, const Eigen::VectorXd& delta
   if (delta.size() != static_cast<int>(indices.size())) {
     throw std::invalid_argument("perturb: delta has the wrong dimension for the class");
   }
-  Eigen::Matrix<double, 7, 1> full = Eigen::Matrix<double, 7, 1>::Zero();
-  for (std::size_t i = 0; i < indices.size(); ++i)
-    full[indices[i]] = delta[i];
-  const Eigen::Vector3d rho = full.head<3>();
-  const Eigen::Vector3d phi = full.segment<3>(3);
-  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
-  const double angle = phi.norm();
-  if (angle > 0)
-    step.linear() = Eigen::AngleAxisd(angle, phi / angle).toRotationMatrix();
-  step.translation() = rho;
-  // pi [+] dpi = (T exp(xi), S + D(s)) in the quadric frame (eqs. 10-17).
-  const Eigen::Isometry3d T = shape.poseInFrame() * step;
-  Eigen::Vector3d scale = shape.scale();
-  scale.x() += full[6];  // alpha; fromPose reads the radial scale from x (y equals it)
-  return PrimitiveShape::fromPose(shape.quadric_class, T, scale);
+  // pi [+] dpi = (T exp(xi), S + D(s)) in the quadric frame (eqs. 9, 11, 16; Table II basis).
+  return PrimitiveShape::fromQuadric(shape.quadric().plusMinimal(delta));
 }
 
 }  // namespace quadric_slam

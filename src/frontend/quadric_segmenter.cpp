@@ -1,5 +1,6 @@
 #include "quadric_slam/frontend/quadric_segmenter.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -8,6 +9,8 @@
 #include <string>
 
 #include "quadric_slam/frontend/cgal_shape_detector.h"
+#include "quadric_slam/frontend/general_quadric_fit.h"
+#include "quadric_slam/geometry/symmetry.h"
 
 namespace quadric_slam {
 
@@ -193,6 +196,79 @@ PrimitiveShape cylinderFromCone(const PrimitiveShape& cone,
   return PrimitiveShape::cylinder(on_axis, d, radius / points.size());
 }
 
+// A cone through the points of a cylinder fit: the radius as a straight line of the axial
+// coordinate, rho = r0 + k z; none (half angle 0) when k vanishes.
+PrimitiveShape coneFromCylinder(const PrimitiveShape& cylinder,
+                                const std::vector<Eigen::Vector3d>& points) {
+  const Eigen::Vector3d d = cylinder.direction;
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  for (const auto& q : points) {
+    const Eigen::Vector3d v = q - cylinder.point;
+    const double z = d.dot(v);
+    const double rho = (v - z * d).norm();
+    const Eigen::Vector2d row(1.0, z);
+    A += row * row.transpose();
+    b += row * rho;
+  }
+  PrimitiveShape cone = PrimitiveShape::cone(cylinder.point, d, 0.0);
+  if (std::abs(A.determinant()) < 1e-18)
+    return cone;
+  const Eigen::Vector2d x = A.ldlt().solve(b);
+  const double r0 = x[0], k = x[1];
+  if (!(std::abs(k) > 1e-6) || !std::isfinite(r0))
+    return cone;
+  // Apex where the radius vanishes; the axis points from it into the opening.
+  cone.point = cylinder.point - (r0 / k) * d;
+  cone.direction = k > 0 ? d : Eigen::Vector3d(-d);
+  cone.size = std::atan(std::abs(k));
+  return cone;
+}
+
+// A cone from points and their normals: every tangent plane passes through the apex
+// (n_i . (apex - p_i) = 0, linear least squares), and the normals lie on a small circle around
+// the axis (the least-variance direction of the centred normals). Catches the side view of a cone,
+// whose visible strip a tilted cylinder also fits. Half angle 0 when degenerate.
+PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
+                               const std::vector<Eigen::Vector3d>& normals) {
+  PrimitiveShape cone = PrimitiveShape::cone(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0);
+  if (points.size() < 10 || points.size() != normals.size())
+    return cone;
+  Eigen::Vector3d mean_n = Eigen::Vector3d::Zero();
+  for (const auto& n : normals)
+    mean_n += n;
+  mean_n /= static_cast<double>(normals.size());
+  Eigen::Matrix3d C = Eigen::Matrix3d::Zero(), A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    C += (normals[i] - mean_n) * (normals[i] - mean_n).transpose();
+    A += normals[i] * normals[i].transpose();
+    b += normals[i] * normals[i].dot(points[i]);
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig_a(A);
+  if (eig.info() != Eigen::Success || eig_a.info() != Eigen::Success ||
+      eig_a.eigenvalues()[0] < 1e-6 * eig_a.eigenvalues()[2])
+    return cone;
+  Eigen::Vector3d axis = eig.eigenvectors().col(0);
+  const Eigen::Vector3d apex = A.ldlt().solve(b);
+  double mean_z = 0;
+  for (const auto& q : points)
+    mean_z += axis.dot(q - apex);
+  if (mean_z < 0)
+    axis = -axis;
+  double angle = 0;
+  for (const auto& q : points) {
+    const Eigen::Vector3d v = q - apex;
+    const double z = axis.dot(v);
+    angle += std::atan2((v - z * axis).norm(), z);
+  }
+  cone.point = apex;
+  cone.direction = axis;
+  cone.size = angle / static_cast<double>(points.size());
+  return cone;
+}
+
 bool plausible(const PrimitiveShape& s, const QuadricSegmenter::Params& p) {
   if (!s.point.allFinite() || !s.direction.allFinite() || !std::isfinite(s.size))
     return false;
@@ -238,6 +314,7 @@ void QuadricSegmenter::Params::validate() const {
           "cgal_stride must be in [1, 16], got " + std::to_string(cgal_stride));
   require(cgal_probability > 0 && cgal_probability < 1,
           "cgal_probability must be in (0, 1), got " + str(cgal_probability));
+  require(quadric_rms_ratio >= 1, "quadric_rms_ratio must be >= 1, got " + str(quadric_rms_ratio));
   require(cgal_min_points >= 4,
           "cgal_min_points must be >= 4, got " + std::to_string(cgal_min_points));
   require(cgal_epsilon > 0, "cgal_epsilon must be > 0 m, got " + str(cgal_epsilon));
@@ -300,11 +377,20 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     centreOnSupport(detection.shape, points);
     (void)shape;
     detection.covariance = fit.covariance;
+    // The fit's covariance is about fit.shape.quadric(); re-centring moves the frame by a symmetry
+    // element G (a slide along the cylinder axis), so re-express it: C' = M C M^T, M = Ad(G^-1).
+    const Eigen::Isometry3d G =
+        fit.shape.quadric().pose().inverse() * detection.shape.quadric().pose();
+    const int k = minimalDimension(detection.shape.quadric_class);
+    if (fit.covariance.rows() == k && fit.covariance.cols() == k) {
+      const Eigen::MatrixXd M = minimalAdjoint(detection.shape.quadric_class, G.inverse());
+      detection.covariance = M * fit.covariance * M.transpose();
+    }
     detection.num_points = static_cast<int>(indices.size());
     detection.fit_rms = rmsDistance(detection.shape, points);
     detection.label = static_cast<std::uint16_t>(result.detections.size() + 1);
     detection.roi = roiOf(indices, width);
-    const Eigen::Isometry3d T_quadric_frame = detection.shape.poseInFrame().inverse();
+    const Eigen::Isometry3d T_quadric_frame = detection.shape.quadric().pose().inverse();
     detection.extent_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
     detection.extent_max = -detection.extent_min;
     for (const auto& q : points) {
@@ -426,6 +512,22 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
         if (as_cylinder.rms < p.cylinder_rms_ratio * fit.rms && plausible(as_cylinder.shape, p))
           fit = as_cylinder;
       }
+      if (fit.shape.quadric_class == QuadricClass::kCylinder && p.detect_cones) {
+        std::vector<Eigen::Vector3d> normals;
+        normals.reserve(indices.size());
+        for (int i : indices)
+          normals.push_back(normalOf(cloud.points[i]).normalized());
+        const ShapeRefiner::Result cylinder = fit;
+        for (const PrimitiveShape& start :
+             {coneFromCylinder(cylinder.shape, points), coneFromNormals(points, normals)}) {
+          if (!plausible(start, p))
+            continue;
+          const ShapeRefiner::Result as_cone = refiner.refine(start, points);
+          if (p.cylinder_rms_ratio * as_cone.rms < cylinder.rms && as_cone.rms < fit.rms &&
+              plausible(as_cone.shape, p))
+            fit = as_cone;
+        }
+      }
       if (fit.shape.quadric_class != QuadricClass::kSphere && p.detect_spheres) {
         const ShapeRefiner::Result as_sphere = refiner.refine(fitSphereAlgebraic(points), points);
         if (as_sphere.rms < p.cylinder_rms_ratio * fit.rms && plausible(as_sphere.shape, p))
@@ -442,6 +544,11 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     const double z = medianDepth(cloud, indices);
     if (fit.rms >
         p.max_rms_factor * depthThreshold(z, p.planes.distance_factor, p.planes.min_distance))
+      continue;
+    // Shape test: residuals well above a general quadric's are shape (e.g. an ellipsoid), not
+    // noise.
+    const GeneralQuadricFit general = fitGeneralQuadric(points);
+    if (general.ok && fit.rms > p.quadric_rms_ratio * general.rms)
       continue;
     accept(fit.shape, indices, fit);
   }
@@ -480,7 +587,7 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
   std::vector<Eigen::Isometry3d> T_quadric_camera(n);
   std::vector<double> cos_angle(n);
   for (int k = 0; k < n; ++k) {
-    T_quadric_camera[k] = coarse.detections[k].shape.poseInFrame().inverse();
+    T_quadric_camera[k] = coarse.detections[k].shape.quadric().pose().inverse();
     cos_angle[k] = std::cos(coarse.detections[k].shape.quadric_class == QuadricClass::kPlane
                                 ? p.planes.max_normal_angle
                                 : p.curved_max_normal_angle);

@@ -1,5 +1,7 @@
 #include "quadric_slam/frontend/segmentation_score.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <utility>
@@ -8,6 +10,81 @@ namespace quadric_slam {
 
 SegmentationScore::SegmentationScore(std::map<int, std::string> truth_classes, int min_pixels)
     : truth_classes_(std::move(truth_classes)), min_pixels_(min_pixels) {}
+
+namespace {
+
+double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+// The two parameter errors of a detection against the true shape of the same class.
+std::pair<double, double> shapeErrors(const PrimitiveShape& d, const PrimitiveShape& t) {
+  switch (t.quadric_class) {
+    case QuadricClass::kPlane: {
+      Eigen::Vector3d n = d.direction;
+      double offset = d.planeOffset();
+      if (n.dot(t.direction) < 0) {
+        n = -n;
+        offset = -offset;
+      }
+      return {angleDeg(n, t.direction), std::abs(offset - t.planeOffset())};
+    }
+    case QuadricClass::kSphere:
+      return {(d.point - t.point).norm(), std::abs(d.size - t.size)};
+    case QuadricClass::kCylinder:
+      return {std::min(angleDeg(d.direction, t.direction), angleDeg(-d.direction, t.direction)),
+              std::abs(d.size - t.size)};
+    default:  // cone: the axis points into the opening
+      return {angleDeg(d.direction, t.direction), std::abs(d.size - t.size) * 180.0 / M_PI};
+  }
+}
+
+}  // namespace
+
+void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat& truth,
+                                 const cv::Mat& valid,
+                                 const std::map<int, PrimitiveShape>& truth_camera,
+                                 double max_error_range) {
+  addFrame(segmentation, truth, valid);
+  std::map<int, int> detection_size;
+  std::map<std::pair<int, int>, int> both;
+  for (int v = 0; v < truth.rows; ++v)
+    for (int u = 0; u < truth.cols; ++u) {
+      if (!valid.at<std::uint8_t>(v, u))
+        continue;
+      const int d = segmentation.labels.at<std::uint16_t>(v, u);
+      ++detection_size[d];
+      ++both[{d, truth.at<std::uint16_t>(v, u)}];
+    }
+  for (const QuadricDetection& d : segmentation.detections) {
+    // The surface holding the detection's majority, of the same class.
+    int majority = 0, majority_pixels = -1;
+    for (const auto& [key, pixels] : both)
+      if (key.first == d.label && pixels > majority_pixels) {
+        majority = key.second;
+        majority_pixels = pixels;
+      }
+    const auto it = truth_camera.find(majority);
+    if (majority == 0 || it == truth_camera.end() ||
+        it->second.quadric_class != d.shape.quadric_class)
+      continue;
+    const Eigen::Vector3d centre = d.shape.quadric().pose() * (0.5 * (d.extent_min + d.extent_max));
+    if (centre.norm() > max_error_range)
+      continue;
+    const auto [first, second] = shapeErrors(d.shape, it->second);
+    ParameterErrors& e = errors_[toString(d.shape.quadric_class)];
+    e.first.push_back(first);
+    e.second.push_back(second);
+  }
+}
+
+double SegmentationScore::median(std::vector<double> values) {
+  if (values.empty())
+    return 0.0;
+  const std::size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
 
 void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat& truth,
                                  const cv::Mat& valid) {
@@ -24,6 +101,7 @@ void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat
       ++both[{d, t}];
     }
   ++frames_;
+  last_missed_.clear();
   auto scored = [&](int id) {
     const auto it = truth_classes_.find(id);
     return it != truth_classes_.end() && (it->second == "plane" || it->second == "sphere" ||
@@ -35,6 +113,7 @@ void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat
     Surface& s = surfaces_[id];
     s.quadric_class = truth_classes_[id];
     ++s.frames_scored;
+    const int detected_before = s.frames_detected;
     for (const QuadricDetection& d : segmentation.detections) {
       if (toString(d.shape.quadric_class) != s.quadric_class)
         continue;
@@ -45,6 +124,8 @@ void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat
         break;
       }
     }
+    if (s.frames_detected == detected_before)
+      last_missed_.push_back(id);
   }
   for (const QuadricDetection& d : segmentation.detections) {
     int majority = 0, majority_pixels = -1;
@@ -82,6 +163,20 @@ std::string SegmentationScore::report() const {
   out << line;
   for (const auto& [kind, count] : spurious_kinds_)
     out << "  spurious: " << count << " x " << kind << "\n";
+  static const std::map<std::string, std::pair<const char*, const char*>> kNames = {
+      {"plane", {"normal angle (deg)", "offset (m)"}},
+      {"sphere", {"centre (m)", "radius (m)"}},
+      {"cylinder", {"axis angle (deg)", "radius (m)"}},
+      {"cone", {"axis angle (deg)", "half angle (deg)"}}};
+  for (const auto& [name, e] : errors_) {
+    const auto it = kNames.find(name);
+    if (it == kNames.end())
+      continue;
+    std::snprintf(line, sizeof(line), "median errors %-8s (%4zu fits): %s %.4f, %s %.4f\n",
+                  name.c_str(), e.first.size(), it->second.first, median(e.first),
+                  it->second.second, median(e.second));
+    out << line;
+  }
   return out.str();
 }
 

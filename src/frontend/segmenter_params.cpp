@@ -67,6 +67,7 @@ const std::vector<Entry>& table() {
       real("max_cone_half_angle", [](Params& p) -> double& { return p.max_cone_half_angle; }),
       real("plane_rms_ratio", [](Params& p) -> double& { return p.plane_rms_ratio; }),
       real("cylinder_rms_ratio", [](Params& p) -> double& { return p.cylinder_rms_ratio; }),
+      real("quadric_rms_ratio", [](Params& p) -> double& { return p.quadric_rms_ratio; }),
       real("max_rms_factor", [](Params& p) -> double& { return p.max_rms_factor; }),
       integer("refine_max_iterations", [](Params& p) -> int& { return p.refiner.max_iterations; }),
       integer("refine_max_points", [](Params& p) -> int& { return p.refiner.max_points; }),

@@ -26,6 +26,17 @@ ShapeRefiner::ShapeRefiner(const Params& params) : params_(params) {
 
 namespace {
 
+// Whether the shape has a core quadric (finite, radius > 0, cone half angle in (0, pi/2)), which
+// the perturbation needs; e.g. a RANSAC cone may come with a half angle beyond pi/2.
+bool validShape(const PrimitiveShape& shape) {
+  try {
+    shape.quadric();
+    return true;
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+}
+
 Eigen::VectorXd residuals(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
   Eigen::VectorXd r(points.size());
   for (std::size_t i = 0; i < points.size(); ++i)
@@ -90,10 +101,21 @@ ShapeRefiner::Result covarianceOf(const PrimitiveShape& shape,
 
 ShapeRefiner::Result ShapeRefiner::refine(const PrimitiveShape& initial,
                                           const std::vector<Eigen::Vector3d>& all_points) const {
+  try {
+    return refineUnchecked(initial, all_points);
+  } catch (const std::invalid_argument&) {  // a shape left its class (no core quadric)
+    Result result;
+    result.shape = initial;
+    return result;
+  }
+}
+
+ShapeRefiner::Result ShapeRefiner::refineUnchecked(
+    const PrimitiveShape& initial, const std::vector<Eigen::Vector3d>& all_points) const {
   Result result;
   result.shape = initial;
   const int k = minimalDimension(initial.quadric_class);
-  if (static_cast<int>(all_points.size()) <= k)
+  if (static_cast<int>(all_points.size()) <= k || !validShape(initial))
     return result;
 
   const std::vector<Eigen::Vector3d> points = subsample(all_points, params_.max_points);
@@ -113,7 +135,13 @@ ShapeRefiner::Result ShapeRefiner::refine(const PrimitiveShape& initial,
       const Eigen::VectorXd delta = A.ldlt().solve(-g);
       if (!delta.allFinite())
         break;
-      const PrimitiveShape candidate = perturb(shape, delta);
+      PrimitiveShape candidate;
+      try {
+        candidate = perturb(shape, delta);
+      } catch (const std::invalid_argument&) {  // step left the class (e.g. negative scale)
+        lambda *= 10;
+        continue;
+      }
       const Eigen::VectorXd r_new = residuals(candidate, points);
       const double cost_new = r_new.squaredNorm();
       if (std::isfinite(cost_new) && cost_new < cost) {
@@ -140,9 +168,14 @@ ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
                                             const std::vector<Eigen::Vector3d>& all_points) const {
   Result result;
   result.shape = shape;
-  if (static_cast<int>(all_points.size()) <= minimalDimension(shape.quadric_class))
+  if (static_cast<int>(all_points.size()) <= minimalDimension(shape.quadric_class) ||
+      !validShape(shape))
     return result;
-  return covarianceOf(shape, subsample(all_points, params_.max_points), all_points.size());
+  try {
+    return covarianceOf(shape, subsample(all_points, params_.max_points), all_points.size());
+  } catch (const std::invalid_argument&) {
+    return result;
+  }
 }
 
 PrimitiveShape fitPlane(const std::vector<Eigen::Vector3d>& points) {

@@ -19,7 +19,6 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/image_encodings.h>
 
-#include <Eigen/Geometry>
 #include <chrono>
 #include <cstring>
 #include <memory>
@@ -28,57 +27,16 @@
 #include <string>
 
 #include "quadric_slam/QuadricObservationArray.h"
+#include "quadric_slam/frontend/detection_measurement.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/params.h"
 
 namespace quadric_slam {
 
 namespace {
-
-// The observation message of one detection (msg/QuadricSurface.msg conventions: pose
-// T_camera_quadric, scale = diag(S), shape vector; covariance row-major in the Table II minimal
-// space).
-QuadricObservation toMessage(const QuadricDetection& d) {
-  QuadricObservation o;
-  const QuadricClass c = d.shape.quadric_class;
-  o.surface.quadric_class = static_cast<std::uint8_t>(c);
-  const Eigen::Vector4d sigma = defaultSignature(c);
-  for (int i = 0; i < 4; ++i)
-    o.surface.signature[i] = static_cast<std::int8_t>(sigma[i]);
-  const Eigen::Isometry3d T_camera_quadric = d.shape.poseInFrame();
-  const Eigen::Quaterniond q(T_camera_quadric.linear());
-  o.surface.pose.position.x = T_camera_quadric.translation().x();
-  o.surface.pose.position.y = T_camera_quadric.translation().y();
-  o.surface.pose.position.z = T_camera_quadric.translation().z();
-  o.surface.pose.orientation.w = q.w();
-  o.surface.pose.orientation.x = q.x();
-  o.surface.pose.orientation.y = q.y();
-  o.surface.pose.orientation.z = q.z();
-  const Eigen::Vector3d scale = d.shape.scale();
-  for (int i = 0; i < 3; ++i)
-    o.surface.scale[i] = scale[i];
-  o.surface.shape = d.shape.shapeVector();
-  o.surface.extent_min.x = d.extent_min.x();
-  o.surface.extent_min.y = d.extent_min.y();
-  o.surface.extent_min.z = d.extent_min.z();
-  o.surface.extent_max.x = d.extent_max.x();
-  o.surface.extent_max.y = d.extent_max.y();
-  o.surface.extent_max.z = d.extent_max.z();
-  o.minimal_dimension = static_cast<std::uint8_t>(minimalDimension(c));
-  for (int r = 0; r < d.covariance.rows(); ++r)
-    for (int col = 0; col < d.covariance.cols(); ++col)
-      o.covariance.push_back(d.covariance(r, col));
-  o.num_points = static_cast<std::uint32_t>(d.num_points);
-  o.label = d.label;
-  o.image_roi.x_offset = static_cast<std::uint32_t>(d.roi.x_offset);
-  o.image_roi.y_offset = static_cast<std::uint32_t>(d.roi.y_offset);
-  o.image_roi.width = static_cast<std::uint32_t>(d.roi.width);
-  o.image_roi.height = static_cast<std::uint32_t>(d.roi.height);
-  o.fit_rms = static_cast<float>(d.fit_rms);
-  return o;
-}
 
 // Empty when the cloud has the fields and layout the segmenter needs, else the problem.
 std::string cloudProblem(const sensor_msgs::PointCloud2& cloud) {
@@ -147,10 +105,11 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
     }
     const Segmentation segmentation = segmenter_->segment(cloud);
 
-    auto out = boost::make_shared<QuadricObservationArray>();
+    // Core measurements (detection_measurement.h) -> messages (ros/conversions.h); the header is
+    // the cloud's, copied exactly (the conversion goes through a double stamp).
+    auto out = boost::make_shared<QuadricObservationArray>(toObservationArrayMsg(
+        toFrameMeasurements(segmentation, msg->header.stamp.toSec(), msg->header.frame_id)));
     out->header = msg->header;
-    for (const QuadricDetection& d : segmentation.detections)
-      out->observations.push_back(toMessage(d));
     observations_pub_.publish(out);
 
     if (image_pub_.getNumSubscribers() > 0)

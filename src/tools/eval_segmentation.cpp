@@ -1,11 +1,15 @@
 // eval_segmentation: the segmenter over a synthetic sequence written by scripts/synth (TUM folder
 // with labels/<stamp>.png and quadrics_gt.yaml): per primitive with enough valid pixels, the share
-// of frames in which its class is detected on it, and the spurious detections per frame.
+// of frames in which its class is detected on it, the spurious detections per frame, and the
+// median parameter errors per class of the detections found within --max-range of the camera
+// (truth: quadrics_gt.yaml moved into the camera frame by groundtruth.txt, T_world_camera).
 //
 //   eval_segmentation DIR [--stride K (1)] [--max-frames N (all)] [--min-pixels P (2000)]
-//                         [--config segmentation.yaml]
+//                         [--max-range M (2.0)] [--config segmentation.yaml]
+//                         [--verbose 1: per frame, the stamp and the ids of missed surfaces]
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -19,8 +23,10 @@
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/frontend/segmentation_score.h"
 #include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/geometry/shapes.h"
 #include "quadric_slam/io/depth_png.h"
 #include "quadric_slam/io/map_yaml.h"
+#include "quadric_slam/io/trajectory_io.h"
 
 namespace qs = quadric_slam;
 
@@ -28,11 +34,13 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr,
                  "usage: eval_segmentation DIR [--stride K] [--max-frames N] [--min-pixels P] "
-                 "[--config segmentation.yaml]\n");
+                 "[--max-range M] [--config segmentation.yaml]\n");
     return 2;
   }
   const std::string dir = argv[1];
   int stride = 1, max_frames = 1 << 30, min_pixels = 2000;
+  double max_range = 2.0;
+  bool verbose = false;
   qs::QuadricSegmenter::Params params;
   try {
     for (int i = 2; i + 1 < argc; i += 2) {
@@ -43,6 +51,10 @@ int main(int argc, char** argv) {
         max_frames = std::atoi(value.c_str());
       else if (arg == "--min-pixels")
         min_pixels = std::atoi(value.c_str());
+      else if (arg == "--verbose")
+        verbose = value == "1";
+      else if (arg == "--max-range")
+        max_range = std::atof(value.c_str());
       else if (arg == "--config")
         params = qs::loadSegmenterParams(value);
       else
@@ -55,8 +67,17 @@ int main(int argc, char** argv) {
     k.cx = camera["cx"].as<double>();
     k.cy = camera["cy"].as<double>();
     std::map<int, std::string> classes;
-    for (const qs::MapFileQuadric& q : qs::readMapYaml(dir + "/quadrics_gt.yaml").quadrics)
+    std::map<int, qs::PrimitiveShape> truth_world;
+    for (const qs::MapFileQuadric& q : qs::readMapYaml(dir + "/quadrics_gt.yaml").quadrics) {
       classes[q.id] = q.quadric_class;
+      if (q.quadric_class == "plane" || q.quadric_class == "sphere" ||
+          q.quadric_class == "cylinder" || q.quadric_class == "cone")
+        truth_world[q.id] = qs::PrimitiveShape::fromQuadric(
+            qs::quadricFromShapeMap(qs::quadricClassFromString(q.quadric_class), q.shape));
+    }
+    std::map<long long, Eigen::Isometry3d> poses;  // stamp in microseconds -> T_world_camera
+    for (const qs::StampedPose& pose : qs::readTumTrajectory(dir + "/groundtruth.txt"))
+      poses[std::llround(pose.stamp * 1e6)] = pose.T_world_sensor;
     qs::SegmentationScore score(classes, min_pixels);
     const qs::NormalEstimator normals{qs::NormalEstimator::Params()};
     const qs::QuadricSegmenter segmenter(params);
@@ -87,7 +108,19 @@ int main(int argc, char** argv) {
       const auto cloud = normals.compute(qs::backProject(view, k, qs::BackProjectionParams()));
       const qs::Segmentation segmentation = segmenter.segment(cloud);
       cv::Mat valid = depth == depth;  // not NaN
-      score.addFrame(segmentation, truth, valid);
+      const auto pose = poses.find(std::llround(std::stod(stamp) * 1e6));
+      if (pose == poses.end())
+        throw std::runtime_error("no ground-truth pose at stamp " + stamp);
+      std::map<int, qs::PrimitiveShape> truth_camera;
+      for (const auto& [id, shape] : truth_world)
+        truth_camera[id] = shape.transformed(pose->second.inverse());
+      score.addFrame(segmentation, truth, valid, truth_camera, max_range);
+      if (verbose && !score.lastMissed().empty()) {
+        std::printf("%s missed:", stamp.c_str());
+        for (int id : score.lastMissed())
+          std::printf(" %d", id);
+        std::printf("\n");
+      }
       ++used;
     }
     std::printf("%s", score.report().c_str());

@@ -34,8 +34,9 @@ class PlaneRegionGrower {
     // Neighbouring depths differing by more than this factor times the depth are not connected
     // (dimensionless), (0, 1].
     double max_depth_jump_factor = 0.04;
-    // Smallest plane (points of the cloud grid), >= 3. Default 1500.
-    int min_points = 1500;
+    // Smallest plane (points of the cloud grid), >= 3. Default 500 (a floor seen far and at a
+    // grazing angle, or in a corner of the image, keeps only a few hundred valid points).
+    int min_points = 500;
     // Largest shape-operator eigenvalue of a plane (1/m); a cylinder of radius r has 1/r. >= 0.
     double max_curvature = 1.5;
     // Regions of one plane split in the image (e.g. a floor behind an object) are merged when

@@ -1,9 +1,6 @@
-// A human-readable primitive (plane, sphere, cylinder, cone) in some frame, its conversion to the
-// quadric pose/scale conventions of msg/QuadricSurface.msg, its geometric distance, and the class's
-// minimal perturbation (Table II subset of (rho, phi, s)).
-//
-// Interim: the geometry core (geometry/quadric.h, geometry/shapes.h) replaces the pose/scale
-// conversion once merged; this struct keeps the segmenter independent of it.
+// A human-readable primitive (plane, sphere, cylinder, cone) in some frame, its geometric distance,
+// and its quadric in the geometry core (geometry/shapes.h quadricFromShape: the pose, scale and
+// Table II minimal perturbation all come from there).
 #pragma once
 
 #include <Eigen/Core>
@@ -13,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "quadric_slam/geometry/quadric.h"
 #include "quadric_slam/geometry/quadric_class.h"
 
 namespace quadric_slam {
@@ -44,15 +42,13 @@ struct PrimitiveShape {
   // center, radius; cylinder point, axis, radius; cone apex, axis, half_angle.
   std::map<std::string, std::vector<double>> schemaShape() const;
 
-  // Pose of the canonical quadric frame (plane normal = x; cylinder/cone axis = z; cone apex =
-  // origin; plane origin = the point, sphere origin = centre, cylinder origin = the axis point)
-  // and the diagonal of S (1/m), as msg/QuadricSurface.msg fixes them.
-  Eigen::Isometry3d poseInFrame() const;
-  Eigen::Vector3d scale() const;
-  // Inverse of (poseInFrame, scale).
-  static PrimitiveShape fromPose(QuadricClass quadric_class,
-                                 const Eigen::Isometry3d& T_frame_quadric,
-                                 const Eigen::Vector3d& scale);
+  // The core quadric of this shape (geometry/shapes.h quadricFromShape: plane normal = quadric x
+  // with origin offset * normal; sphere origin = centre; cylinder origin = the axis point, axis =
+  // quadric z; cone origin = apex, axis = quadric z). Throws std::invalid_argument for class
+  // general or an invalid size.
+  QuadricModel quadric() const;
+  // Inverse of quadric() (planeShape, sphereShape, ... of geometry/shapes.h).
+  static PrimitiveShape fromQuadric(const QuadricModel& quadric);
 
   // Signed geometric distance (m) of a point (same frame) to the surface: plane n.p - offset,
   // sphere |p - c| - r, cylinder (distance to axis) - r, cone rho cos(a) - z sin(a) in the cone
@@ -65,16 +61,15 @@ struct PrimitiveShape {
   PrimitiveShape transformed(const Eigen::Isometry3d& T_b_a) const;
 };
 
-// The minimal parameters of a class (Table II) as indices into the 7-vector
-// (rho1, rho2, rho3, phi1, phi2, phi3, s) of a right perturbation in the quadric frame:
-// T' = T_frame_quadric * (Rot(phi), rho), S' = S + s on the radial scale entries.
-// plane (rho1, phi2, phi3); sphere (rho1..3, s); cylinder (rho1, rho2, phi1, phi2, s);
-// cone (rho1..3, phi1, phi2, s). The scale s perturbs alpha (sphere: 1/r; cylinder: 1/r on x and
-// y; cone: 1/tan(half_angle) on x and y).
+// The minimal parameters of a class (Table II, geometry/quadric_classes.h basis) as indices into
+// the 7-vector (rho1, rho2, rho3, phi1, phi2, phi3, s) of a right (body-frame) perturbation of
+// shape.quadric(): plane (rho1, phi2, phi3); sphere (rho1..3, s); cylinder (rho1, rho2, phi1, phi2,
+// s); cone (rho1..3, phi1, phi2, s). The scale s perturbs alpha (sphere: 1/r on all three;
+// cylinder: 1/r on x and y; cone: 1/tan(half_angle) on x and y).
 const std::vector<int>& minimalIndices(QuadricClass quadric_class);
 
-// pi [+] delta (eqs. 10-17, right-perturbation form, first order in phi): delta has
-// minimalDimension(class) entries ordered as minimalIndices().
+// pi [+] delta (eqs. 9-17) through the core: fromQuadric(shape.quadric().plusMinimal(delta)),
+// delta with minimalDimension(class) entries ordered as minimalIndices().
 PrimitiveShape perturb(const PrimitiveShape& shape, const Eigen::VectorXd& delta);
 
 }  // namespace quadric_slam

@@ -32,16 +32,16 @@ namespace quadric_slam {
 // One segmented primitive, in the frame of the input cloud (the camera frame).
 struct QuadricDetection {
   PrimitiveShape shape;
-  // Covariance of the fit in the class's minimal coordinates (primitive_shape.h minimalIndices:
-  // plane (rho1, phi2, phi3); sphere (rho1..3, alpha); cylinder (rho1, rho2, phi1, phi2, alpha);
-  // cone (rho1..3, phi1, phi2, alpha); right perturbation in the quadric frame of
-  // shape.poseInFrame(), alpha the radial entry of S): sigma^2 (J^T J)^-1 of the least squares.
+  // Covariance of the fit in the class's minimal coordinates (Table II, geometry/quadric_classes.h
+  // basis: plane (rho1, phi2, phi3); sphere (rho1..3, s); cylinder (rho1, rho2, phi1, phi2, s);
+  // cone (rho1..3, phi1, phi2, s)), a right (body-frame) perturbation of shape.quadric() with s
+  // the radial entry of S: sigma^2 (J^T J)^-1 of the least squares.
   Eigen::MatrixXd covariance;
   int num_points = 0;    // supporting points (cloud grid)
   double fit_rms = 0.0;  // RMS geometric distance of the supporting points (m)
   std::uint16_t label = 0;
   ImageRoi roi;  // bounding box of the supporting pixels in the cloud's grid
-  // Axis-aligned box of the supporting points in the quadric frame of shape.poseInFrame() (m).
+  // Axis-aligned box of the supporting points in the frame of shape.quadric() (m).
   Eigen::Vector3d extent_min = Eigen::Vector3d::Zero(), extent_max = Eigen::Vector3d::Zero();
 };
 
@@ -105,8 +105,14 @@ class QuadricSegmenter {
     // plane_rms_ratio * curved RMS) is a plane; a cone or cylinder whose RMS is not clearly
     // better than that of a simpler class (cone -> cylinder -> sphere; RMS of the simpler <
     // cylinder_rms_ratio * its own) becomes the simpler class. Ratios >= 1.
+    // A cylinder is also fitted as a cone (a truncated cone with a small half angle looks like a
+    // cylinder) and becomes one when the cone's RMS is below its own / cylinder_rms_ratio.
     double plane_rms_ratio = 1.5;
     double cylinder_rms_ratio = 1.15;
+    // Shape test: a curved fit whose RMS exceeds quadric_rms_ratio times that of a general quadric
+    // fitted to the same points (general_quadric_fit.h) has residuals of shape, not noise (e.g. a
+    // sphere on an ellipsoid) and is dropped. >= 1; default 1.3.
+    double quadric_rms_ratio = 1.3;
     // Largest fit RMS of a curved segment, relative to its distance threshold at the median
     // depth, (0, 10].
     double max_rms_factor = 0.6;

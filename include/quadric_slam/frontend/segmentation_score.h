@@ -5,6 +5,7 @@
 #include <map>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "quadric_slam/frontend/quadric_segmenter.h"
 
@@ -24,12 +25,22 @@ class SegmentationScore {
   // lies on no surface or on a surface of another class.
   void addFrame(const Segmentation& segmentation, const cv::Mat& truth, const cv::Mat& valid);
 
+  // The same, and the parameter errors of the detections counted as found, against the true
+  // shapes in the camera frame (surface id -> shape): plane normal angle (deg) and offset (m),
+  // sphere centre (m) and radius (m), cylinder axis angle (deg, as lines) and radius (m), cone axis
+  // angle (deg) and half angle (deg). Only detections whose support centre lies within
+  // max_error_range (m) of the camera count.
+  void addFrame(const Segmentation& segmentation, const cv::Mat& truth, const cv::Mat& valid,
+                const std::map<int, PrimitiveShape>& truth_camera, double max_error_range = 2.0);
+
   struct Surface {
     std::string quadric_class;
     int frames_scored = 0, frames_detected = 0;
     double rate() const { return frames_scored ? double(frames_detected) / frames_scored : 0.0; }
   };
   const std::map<int, Surface>& surfaces() const { return surfaces_; }
+  // Scored surfaces not detected in the last frame added.
+  const std::vector<int>& lastMissed() const { return last_missed_; }
   int frames() const { return frames_; }
   int spurious() const { return spurious_; }
   double spuriousPerFrame() const { return frames_ ? double(spurious_) / frames_ : 0.0; }
@@ -39,6 +50,13 @@ class SegmentationScore {
   double spuriousPerFrameOnModelled() const {
     return frames_ ? double(spurious_ - spurious_unmodelled_) / frames_ : 0.0;
   }
+  // Per class name: the two error kinds above, one entry per found detection within range.
+  struct ParameterErrors {
+    std::vector<double> first, second;  // plane angle/offset; sphere centre/radius; ...
+  };
+  const std::map<std::string, ParameterErrors>& parameterErrors() const { return errors_; }
+  // Median of a list (0 when empty).
+  static double median(std::vector<double> values);
   std::string report() const;
 
  private:
@@ -46,7 +64,9 @@ class SegmentationScore {
   int min_pixels_;
   std::map<int, Surface> surfaces_;
   int frames_ = 0, spurious_ = 0, spurious_unmodelled_ = 0;
-  std::map<std::string, int> spurious_kinds_;  // "<detected class> on <surface class>" -> count
+  std::map<std::string, int> spurious_kinds_;
+  std::map<std::string, ParameterErrors> errors_;
+  std::vector<int> last_missed_;  // "<detected class> on <surface class>" -> count
 };
 
 }  // namespace quadric_slam

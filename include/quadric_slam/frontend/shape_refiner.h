@@ -44,6 +44,9 @@ class ShapeRefiner {
   Result evaluate(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) const;
 
  private:
+  Result refineUnchecked(const PrimitiveShape& initial,
+                         const std::vector<Eigen::Vector3d>& points) const;
+
   Params params_;
 };
 

@@ -1,6 +1,6 @@
-// PrimitiveShape: the msg/QuadricSurface.msg pose/scale conventions checked against the quadric
-// equation (S p_Q)^T D(sigma) (S p_Q) + sigma_4 = 0 (eq. 5), round trips, distances, the minimal
-// perturbation; ShapeRefiner on exact and noisy samples.
+// PrimitiveShape: its core quadric (geometry/shapes.h) checked against the quadric equation
+// (S p_Q)^T D(sigma) (S p_Q) + sigma_4 = 0 (eq. 5), round trips, distances, the minimal
+// perturbation (the core's Table II plusMinimal); ShapeRefiner on exact and noisy samples.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -9,6 +9,7 @@
 
 #include "quadric_slam/frontend/primitive_shape.h"
 #include "quadric_slam/frontend/shape_refiner.h"
+#include "quadric_slam/geometry/quadric_classes.h"
 
 namespace qs = quadric_slam;
 using qs::PrimitiveShape;
@@ -28,7 +29,7 @@ std::vector<PrimitiveShape> someShapes() {
 std::vector<Eigen::Vector3d> surfaceSamples(const PrimitiveShape& s, int n, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> uni(-1.0, 1.0);
-  const Eigen::Isometry3d T = s.poseInFrame();
+  const Eigen::Isometry3d T = s.quadric().pose();
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < n; ++i) {
     Eigen::Vector3d q;
@@ -61,8 +62,8 @@ std::vector<Eigen::Vector3d> surfaceSamples(const PrimitiveShape& s, int n, unsi
 
 TEST(PrimitiveShape, PoseAndScaleSatisfyTheQuadricEquationOfTheMessageConvention) {
   for (const PrimitiveShape& s : someShapes()) {
-    const Eigen::Isometry3d T_frame_quadric = s.poseInFrame();
-    const Eigen::Vector3d scale = s.scale();
+    const Eigen::Isometry3d T_frame_quadric = s.quadric().pose();
+    const Eigen::Vector3d scale = s.quadric().scale();
     const Eigen::Vector4d sigma = qs::defaultSignature(s.quadric_class);
     for (const Eigen::Vector3d& p : surfaceSamples(s, 50, 3)) {
       EXPECT_NEAR(s.distance(p), 0.0, 1e-9);
@@ -72,23 +73,22 @@ TEST(PrimitiveShape, PoseAndScaleSatisfyTheQuadricEquationOfTheMessageConvention
       EXPECT_NEAR(value, 0.0, 1e-9) << qs::toString(s.quadric_class);
     }
     // A point off the surface does not satisfy it.
-    const Eigen::Vector3d off = s.poseInFrame() * Eigen::Vector3d(0.5, 0.4, 0.3);
+    const Eigen::Vector3d off = s.quadric().pose() * Eigen::Vector3d(0.5, 0.4, 0.3);
     EXPECT_GT(std::abs(s.distance(off)), 1e-3);
   }
   // Plane normal = quadric x axis; cylinder/cone axis = quadric z; cone apex = origin.
   const auto shapes = someShapes();
-  EXPECT_NEAR((shapes[0].poseInFrame().linear().col(0) - shapes[0].direction).norm(), 0, 1e-12);
-  EXPECT_NEAR((shapes[2].poseInFrame().linear().col(2) - shapes[2].direction).norm(), 0, 1e-12);
-  EXPECT_NEAR((shapes[3].poseInFrame().translation() - shapes[3].point).norm(), 0, 1e-12);
-  EXPECT_NEAR(shapes[3].scale().x(), 1.0 / std::tan(0.35), 1e-12);
-  EXPECT_NEAR(shapes[2].scale().x(), 1.0 / 0.06, 1e-9);
-  EXPECT_DOUBLE_EQ(shapes[2].scale().z(), 1.0);
+  EXPECT_NEAR((shapes[0].quadric().pose().linear().col(0) - shapes[0].direction).norm(), 0, 1e-12);
+  EXPECT_NEAR((shapes[2].quadric().pose().linear().col(2) - shapes[2].direction).norm(), 0, 1e-12);
+  EXPECT_NEAR((shapes[3].quadric().pose().translation() - shapes[3].point).norm(), 0, 1e-12);
+  EXPECT_NEAR(shapes[3].quadric().scale().x(), 1.0 / std::tan(0.35), 1e-12);
+  EXPECT_NEAR(shapes[2].quadric().scale().x(), 1.0 / 0.06, 1e-9);
+  EXPECT_DOUBLE_EQ(shapes[2].quadric().scale().z(), 1.0);
 }
 
-TEST(PrimitiveShape, FromPoseInvertsPoseAndScale) {
+TEST(PrimitiveShape, FromQuadricInvertsQuadric) {
   for (const PrimitiveShape& s : someShapes()) {
-    const PrimitiveShape back =
-        PrimitiveShape::fromPose(s.quadric_class, s.poseInFrame(), s.scale());
+    const PrimitiveShape back = PrimitiveShape::fromQuadric(s.quadric());
     const std::vector<double> a = s.shapeVector(), b = back.shapeVector();
     ASSERT_EQ(a.size(), b.size());
     for (std::size_t i = 0; i < a.size(); ++i)
@@ -101,7 +101,7 @@ TEST(PrimitiveShape, PerturbationHasTheTableTwoDimensionAndMovesTheSurface) {
     const int k = qs::minimalDimension(s.quadric_class);
     EXPECT_EQ(static_cast<int>(qs::minimalIndices(s.quadric_class).size()), k);
     const PrimitiveShape same = qs::perturb(s, Eigen::VectorXd::Zero(k));
-    const Eigen::Vector3d probe = s.poseInFrame() * Eigen::Vector3d(0.3, 0.2, 0.4);
+    const Eigen::Vector3d probe = s.quadric().pose() * Eigen::Vector3d(0.3, 0.2, 0.4);
     EXPECT_NEAR(same.distance(probe), s.distance(probe), 1e-12);
     // Every minimal direction changes the surface (no gauge direction in the minimal set).
     const std::vector<Eigen::Vector3d> samples = surfaceSamples(s, 200, 5);
@@ -113,6 +113,33 @@ TEST(PrimitiveShape, PerturbationHasTheTableTwoDimensionAndMovesTheSurface) {
     }
   }
   EXPECT_THROW(qs::perturb(someShapes()[0], Eigen::VectorXd::Zero(4)), std::invalid_argument);
+}
+
+TEST(PrimitiveShape, MinimalIndicesAreTheTableTwoBasisAndPerturbIsTheCorePlus) {
+  for (const PrimitiveShape& s : someShapes()) {
+    const qs::QuadricClassDefinition& def = qs::classDefinition(s.quadric_class);
+    const std::vector<int>& idx = qs::minimalIndices(s.quadric_class);
+    ASSERT_EQ(static_cast<int>(idx.size()), def.minimal_dimension);
+    for (std::size_t j = 0; j < idx.size(); ++j) {
+      // Pose entries 0..5 are the unit column; the scale entry 6 is the tied scale column.
+      const int row = idx[j] < 6 ? idx[j] : 6;
+      EXPECT_DOUBLE_EQ(def.basis(row, static_cast<int>(j)), 1.0)
+          << qs::toString(s.quadric_class) << " column " << j;
+    }
+    // perturb() and the core's plusMinimal give the same surface.
+    const int k = def.minimal_dimension;
+    Eigen::VectorXd delta = Eigen::VectorXd::LinSpaced(k, 0.01, 0.02);
+    const PrimitiveShape moved = qs::perturb(s, delta);
+    const qs::QuadricModel core = s.quadric().plusMinimal(delta);
+    const std::vector<Eigen::Vector3d> samples = surfaceSamples(moved, 100, 4);
+    for (const Eigen::Vector3d& p : samples) {
+      const Eigen::Vector3d sp = core.scale().asDiagonal() * (core.pose().inverse() * p);
+      const Eigen::Vector4d sig = core.signature();
+      EXPECT_NEAR(sig[0] * sp[0] * sp[0] + sig[1] * sp[1] * sp[1] + sig[2] * sp[2] * sp[2] + sig[3],
+                  0.0, 1e-9)
+          << qs::toString(s.quadric_class);
+    }
+  }
 }
 
 TEST(ShapeRefiner, RecoversEachClassFromAPerturbedStartAndScalesCovarianceWithNoise) {
@@ -160,4 +187,17 @@ TEST(ShapeRefiner, ParamsValidateNamesTheField) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("max_iterations"), std::string::npos);
   }
+}
+
+TEST(ShapeRefiner, AShapeWithoutACoreQuadricIsNotRefinedAndDoesNotThrow) {
+  // A RANSAC cone may come with a half angle beyond pi/2: no quadric, no perturbation.
+  const PrimitiveShape bad =
+      PrimitiveShape::cone(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0, 1), 2.2);
+  EXPECT_THROW(bad.quadric(), std::invalid_argument);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 50; ++i)
+    points.emplace_back(0.01 * i, 0.02 * (i % 7), 1.5);
+  const qs::ShapeRefiner refiner;
+  EXPECT_FALSE(refiner.refine(bad, points).ok);
+  EXPECT_FALSE(refiner.evaluate(bad, points).ok);
 }

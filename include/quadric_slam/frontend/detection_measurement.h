@@ -1,0 +1,22 @@
+// A segmenter detection as the front-end's measurement for the back-end (frontend/observation.h),
+// through the geometry core: quadric_camera = detection.shape.quadric() (geometry/shapes.h), whose
+// frame the detection's covariance (Table II minimal space, body-frame perturbation) and extent box
+// already refer to.
+#pragma once
+
+#include <string>
+
+#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/frontend/quadric_segmenter.h"
+
+namespace quadric_slam {
+
+// Throws std::invalid_argument when the covariance is not k x k for the class's minimal dimension
+// k (or empty, which is passed on as empty), or the shape is invalid (see PrimitiveShape::quadric).
+QuadricMeasurement toMeasurement(const QuadricDetection& detection);
+
+// All detections of one frame, in detection order.
+FrameMeasurements toFrameMeasurements(const Segmentation& segmentation, double stamp,
+                                      const std::string& frame_id);
+
+}  // namespace quadric_slam

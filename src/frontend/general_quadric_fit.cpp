@@ -1,0 +1,123 @@
+#include "quadric_slam/frontend/general_quadric_fit.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <cmath>
+
+namespace quadric_slam {
+
+namespace {
+
+using Vector10d = Eigen::Matrix<double, 10, 1>;
+
+Vector10d monomials(const Eigen::Vector3d& x) {
+  Vector10d m;
+  m << x.x() * x.x(), x.y() * x.y(), x.z() * x.z(), x.x() * x.y(), x.x() * x.z(), x.y() * x.z(),
+      x.x(), x.y(), x.z(), 1.0;
+  return m;
+}
+
+// f(x) and its gradient for coefficients c (normalised coordinates).
+double value(const Vector10d& c, const Eigen::Vector3d& x, Eigen::Vector3d* gradient) {
+  *gradient = Eigen::Vector3d(2 * c[0] * x.x() + c[3] * x.y() + c[4] * x.z() + c[6],
+                              2 * c[1] * x.y() + c[3] * x.x() + c[5] * x.z() + c[7],
+                              2 * c[2] * x.z() + c[4] * x.x() + c[5] * x.y() + c[8]);
+  return c.dot(monomials(x));
+}
+
+double sampson(const Vector10d& c, const Eigen::Vector3d& x) {
+  Eigen::Vector3d g;
+  const double f = value(c, x, &g);
+  return f / std::max(g.norm(), 1e-12);
+}
+
+Eigen::VectorXd residuals(const Vector10d& c, const std::vector<Eigen::Vector3d>& x) {
+  Eigen::VectorXd r(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i)
+    r[i] = sampson(c, x[i]);
+  return r;
+}
+
+}  // namespace
+
+double GeneralQuadricFit::distance(const Eigen::Vector3d& p) const {
+  return spread * sampson(coefficients, (p - centre) / spread);
+}
+
+GeneralQuadricFit fitGeneralQuadric(const std::vector<Eigen::Vector3d>& all_points, int max_points,
+                                    int iterations) {
+  GeneralQuadricFit fit;
+  if (all_points.size() < 20)
+    return fit;
+  std::vector<Eigen::Vector3d> points;
+  const std::size_t n = std::min<std::size_t>(all_points.size(), std::max(20, max_points));
+  const double step = static_cast<double>(all_points.size()) / static_cast<double>(n);
+  for (std::size_t i = 0; i < n; ++i)
+    points.push_back(all_points[static_cast<std::size_t>(i * step)]);
+
+  for (const auto& p : points)
+    fit.centre += p;
+  fit.centre /= static_cast<double>(n);
+  double s2 = 0;
+  for (const auto& p : points)
+    s2 += (p - fit.centre).squaredNorm();
+  fit.spread = std::max(std::sqrt(s2 / static_cast<double>(n)), 1e-9);
+  std::vector<Eigen::Vector3d> x;
+  x.reserve(n);
+  for (const auto& p : points)
+    x.push_back((p - fit.centre) / fit.spread);
+
+  // Algebraic fit: min |D c| subject to |c| = 1.
+  Eigen::Matrix<double, 10, 10> M = Eigen::Matrix<double, 10, 10>::Zero();
+  for (const auto& xi : x) {
+    const Vector10d m = monomials(xi);
+    M += m * m.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 10, 10>> eig(M);
+  Vector10d c = eig.eigenvectors().col(0);
+
+  // Levenberg-Marquardt on the Sampson distances (scale-free in c: renormalised each step).
+  Eigen::VectorXd r = residuals(c, x);
+  double cost = r.squaredNorm();
+  double lambda = 1e-3;
+  for (int it = 0; it < iterations; ++it) {
+    Eigen::MatrixXd J(x.size(), 10);
+    constexpr double h = 1e-7;
+    for (int j = 0; j < 10; ++j) {
+      Vector10d cp = c, cm = c;
+      cp[j] += h;
+      cm[j] -= h;
+      J.col(j) = (residuals(cp, x) - residuals(cm, x)) / (2 * h);
+    }
+    const Eigen::MatrixXd H = J.transpose() * J;
+    const Eigen::VectorXd g = J.transpose() * r;
+    bool improved = false;
+    for (int attempt = 0; attempt < 6 && !improved; ++attempt) {
+      Eigen::MatrixXd A = H;
+      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-12);
+      Vector10d candidate = c + A.ldlt().solve(-g);
+      if (!candidate.allFinite())
+        break;
+      candidate.normalize();
+      const Eigen::VectorXd r_new = residuals(candidate, x);
+      const double cost_new = r_new.squaredNorm();
+      if (std::isfinite(cost_new) && cost_new < cost) {
+        c = candidate;
+        r = r_new;
+        cost = cost_new;
+        lambda = std::max(lambda / 10, 1e-9);
+        improved = true;
+      } else {
+        lambda *= 10;
+      }
+    }
+    if (!improved)
+      break;
+  }
+  fit.coefficients = c;
+  fit.rms = fit.spread * std::sqrt(cost / static_cast<double>(n));
+  fit.ok = true;
+  return fit;
+}
+
+}  // namespace quadric_slam
