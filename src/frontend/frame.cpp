@@ -30,6 +30,17 @@ void BackProjectionParams::validate() const {
   }
 }
 
+bool parseIntrinsics(const std::string& text, CameraIntrinsics& k) {
+  std::stringstream in(text);
+  CameraIntrinsics parsed = k;
+  char c1 = 0, c2 = 0, c3 = 0;
+  in >> parsed.fx >> c1 >> parsed.fy >> c2 >> parsed.cx >> c3 >> parsed.cy;
+  if (!in || c1 != ',' || c2 != ',' || c3 != ',')
+    return false;
+  k = parsed;
+  return true;
+}
+
 std::string imageSizeProblem(const CameraIntrinsics& intrinsics, int width, int height) {
   const std::string intrinsics_problem = intrinsics.problem();
   if (!intrinsics_problem.empty())

@@ -28,13 +28,6 @@ int usage() {
   return 2;
 }
 
-bool parseIntrinsics(const std::string& text, qs::CameraIntrinsics& k) {
-  std::stringstream in(text);
-  char c1 = 0, c2 = 0, c3 = 0;
-  return static_cast<bool>(in >> k.fx >> c1 >> k.fy >> c2 >> k.cx >> c3 >> k.cy) && c1 == ',' &&
-         c2 == ',' && c3 == ',';
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -56,7 +49,7 @@ int main(int argc, char** argv) {
     if (arg == "--out") {
       out_dir = value;
     } else if (arg == "--intrinsics") {
-      if (!parseIntrinsics(value, intrinsics))
+      if (!qs::parseIntrinsics(value, intrinsics))
         return usage();
     } else if (arg == "--depth-scale") {
       units_per_metre = std::atof(value.c_str());

@@ -76,11 +76,7 @@ bool parseOptions(int argc, char** argv, Options& o, std::string& problem) {
       } else if (arg == "--quiet") {
         o.quiet = true;
       } else if (arg == "--intrinsics") {
-        std::stringstream in(value());
-        char c1 = 0, c2 = 0, c3 = 0;
-        in >> o.intrinsics.fx >> c1 >> o.intrinsics.fy >> c2 >> o.intrinsics.cx >> c3 >>
-            o.intrinsics.cy;
-        if (!in || c1 != ',' || c2 != ',' || c3 != ',')
+        if (!qs::parseIntrinsics(value(), o.intrinsics))
           throw std::invalid_argument("--intrinsics takes fx,fy,cx,cy");
       } else if (!arg.empty() && arg[0] == '-') {
         throw std::invalid_argument("unknown option " + arg);

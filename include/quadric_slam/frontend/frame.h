@@ -88,6 +88,10 @@ pcl::PointCloud<pcl::PointXYZ> backProject(const DepthImageView<T>& depth,
   return cloud;
 }
 
+// Parses "fx,fy,cx,cy" (the tools' --intrinsics) into k, leaving width/height; false when
+// malformed.
+bool parseIntrinsics(const std::string& text, CameraIntrinsics& k);
+
 // Empty when an image of width x height fits these intrinsics, else the reason.
 std::string imageSizeProblem(const CameraIntrinsics& intrinsics, int width, int height);
 

@@ -247,6 +247,13 @@ TEST(CameraIntrinsics, ProblemsAreNamed) {
   EXPECT_TRUE(k.valid());
   EXPECT_TRUE(qs::imageSizeProblem(k, 640, 480).empty());
   EXPECT_NE(qs::imageSizeProblem(k, 320, 240).find("320 x 240"), std::string::npos);
+  EXPECT_TRUE(qs::parseIntrinsics("535.4,539.2,320.1,247.6", k));
+  EXPECT_DOUBLE_EQ(k.fy, 539.2);
+  EXPECT_DOUBLE_EQ(k.cy, 247.6);
+  EXPECT_EQ(k.width, 640);
+  EXPECT_FALSE(qs::parseIntrinsics("535.4,539.2,320.1", k));
+  EXPECT_FALSE(qs::parseIntrinsics("535.4;539.2;320.1;247.6", k));
+  EXPECT_DOUBLE_EQ(k.fx, 535.4) << "a malformed string leaves the intrinsics unchanged";
   k.fx = 0;
   EXPECT_FALSE(k.valid());
   EXPECT_NE(qs::imageSizeProblem(k, 640, 480).find("focal"), std::string::npos);
