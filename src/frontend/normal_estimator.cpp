@@ -58,18 +58,15 @@ NormalEstimator::NormalEstimator(const Params& params) : params_(params) {
 
 pcl::PointCloud<pcl::PointNormal> NormalEstimator::compute(
     const pcl::PointCloud<pcl::PointXYZ>& cloud) const {
+  pcl::PointCloud<pcl::PointNormal> out;
+  compute(cloud, out);
+  return out;
+}
+
+void NormalEstimator::compute(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                              pcl::PointCloud<pcl::PointNormal>& out) const {
   if (!cloud.isOrganized()) {
     throw std::invalid_argument("NormalEstimator::compute needs an organized cloud");
-  }
-  pcl::PointCloud<pcl::PointNormal> out(cloud.width, cloud.height);
-  out.header = cloud.header;
-  out.is_dense = false;
-  if (cloud.empty())
-    return out;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    out[i].x = cloud[i].x;
-    out[i].y = cloud[i].y;
-    out[i].z = cloud[i].z;
   }
   if (params_.method == kOwnMethod) {
     BoxGradientSettings settings;
@@ -79,7 +76,18 @@ pcl::PointCloud<pcl::PointNormal> NormalEstimator::compute(
     settings.threads = params_.threads;
     settings.stride = params_.normal_stride;
     computeBoxGradientNormals(cloud, settings, out);
-    return out;
+    return;
+  }
+  if (out.width != cloud.width || out.height != cloud.height || out.size() != cloud.size())
+    out = pcl::PointCloud<pcl::PointNormal>(cloud.width, cloud.height);
+  out.header = cloud.header;
+  out.is_dense = false;
+  if (cloud.empty())
+    return;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    out[i].x = cloud[i].x;
+    out[i].y = cloud[i].y;
+    out[i].z = cloud[i].z;
   }
 
   pcl::PointCloud<pcl::Normal> normals;
@@ -111,7 +119,6 @@ pcl::PointCloud<pcl::PointNormal> NormalEstimator::compute(
       p.normal_x = p.normal_y = p.normal_z = p.curvature = nan;
     }
   }
-  return out;
 }
 
 }  // namespace quadric_slam

@@ -41,6 +41,10 @@ class NormalEstimator {
   // size and points; where a normal cannot be estimated (no data, discontinuity, border) its
   // normal and curvature are NaN. Throws std::invalid_argument for an unorganized cloud.
   pcl::PointCloud<pcl::PointNormal> compute(const pcl::PointCloud<pcl::PointXYZ>& cloud) const;
+  // The same into out, whose storage is reused when it already has the input's size (a stream of
+  // frames then allocates nothing per frame).
+  void compute(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+               pcl::PointCloud<pcl::PointNormal>& out) const;
 
   const Params& params() const { return params_; }
 
