@@ -33,6 +33,11 @@ bool hasData(const pcl::PointXYZ& p) {
   return std::abs(p.x) <= limit && std::abs(p.y) <= limit && p.z > 0.f && p.z <= limit;
 }
 
+// The depth of a point with data, NaN otherwise (NaN fails every comparison below).
+float depthIfData(const pcl::PointXYZ& p) {
+  return hasData(p) ? p.z : std::numeric_limits<float>::quiet_NaN();
+}
+
 // Marks edge pixels (1): without data, or whose right or lower neighbour jumps in depth by more
 // than factor * depth. Returns the largest absolute coordinate of the points with data.
 float markEdges(const pcl::PointCloud<pcl::PointXYZ>& cloud, float factor, int threads,
@@ -41,25 +46,34 @@ float markEdges(const pcl::PointCloud<pcl::PointXYZ>& cloud, float factor, int t
   edge.resize(cloud.size());
   std::vector<float> bounds(static_cast<std::size_t>(std::max(1, threads)), 0.f);
   forEachChunk(height, threads, [&](int chunk, int v_begin, int v_end) {
+    // Depths (NaN = no data) of the current row and the one below, each computed once.
+    std::vector<float> depth(width), depth_below(width);
+    const auto fill = [&](int v, std::vector<float>& out) {
+      const pcl::PointXYZ* row = &cloud.points[static_cast<std::size_t>(v) * width];
+      for (int u = 0; u < width; ++u)
+        out[u] = depthIfData(row[u]);
+    };
+    fill(v_begin, depth);
     float bound = 0.f;
     for (int v = v_begin; v < v_end; ++v) {
+      if (v + 1 < height)
+        fill(v + 1, depth_below);
+      else
+        std::fill(depth_below.begin(), depth_below.end(), std::numeric_limits<float>::quiet_NaN());
       const pcl::PointXYZ* row = &cloud.points[static_cast<std::size_t>(v) * width];
-      const pcl::PointXYZ* below = v + 1 < height ? row + width : nullptr;
       std::uint8_t* edge_row = &edge[static_cast<std::size_t>(v) * width];
       for (int u = 0; u < width; ++u) {
-        const pcl::PointXYZ& p = row[u];
-        if (!hasData(p)) {
+        const float z = depth[u];
+        if (!(z > 0.f)) {
           edge_row[u] = 1;
           continue;
         }
-        bound = std::max({bound, std::abs(p.x), std::abs(p.y), p.z});
-        const float limit = factor * p.z;
-        const bool jump_right =
-            u + 1 < width && hasData(row[u + 1]) && std::abs(row[u + 1].z - p.z) > limit;
-        const bool jump_down =
-            below != nullptr && hasData(below[u]) && std::abs(below[u].z - p.z) > limit;
-        edge_row[u] = jump_right || jump_down ? 1 : 0;
+        bound = std::max({bound, std::abs(row[u].x), std::abs(row[u].y), z});
+        const float limit = factor * z;
+        const bool jump_right = u + 1 < width && std::abs(depth[u + 1] - z) > limit;
+        edge_row[u] = jump_right || std::abs(depth_below[u] - z) > limit ? 1 : 0;
       }
+      depth.swap(depth_below);
     }
     bounds[static_cast<std::size_t>(chunk)] = bound;
   });
@@ -124,9 +138,9 @@ class SummedAreaRing {
       here[0] = running;
       for (int u = 0; u < width_; ++u) {
         if (edges[u] == 0) {
-          running.x += static_cast<std::uint32_t>(std::lrint(points[u].x * scale_));
-          running.y += static_cast<std::uint32_t>(std::lrint(points[u].y * scale_));
-          running.z += static_cast<std::uint32_t>(std::lrint(points[u].z * scale_));
+          running.x += quantised(points[u].x);
+          running.y += quantised(points[u].y);
+          running.z += quantised(points[u].z);
         } else {
           // An edge pixel adds only its flag: a box holding one is never summed.
           running.edges += 1;
@@ -143,6 +157,13 @@ class SummedAreaRing {
     while (size < rows_needed)
       size *= 2;
     return size;
+  }
+  // Rounded to the nearest step (half away from zero), as one truncating conversion: std::lrint is
+  // a library call here and would dominate the table build.
+  std::uint32_t quantised(float value) const {
+    const float scaled = value * scale_;
+    return static_cast<std::uint32_t>(
+        static_cast<std::int32_t>(scaled + (scaled >= 0.f ? 0.5f : -0.5f)));
   }
   Cell* mutableRow(int i) { return &cells_[static_cast<std::size_t>(i & mask_) * (width_ + 1)]; }
 
