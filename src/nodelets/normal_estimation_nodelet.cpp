@@ -83,9 +83,9 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
       drop(problem);
       return;
     }
-    const pcl::PointCloud<pcl::PointNormal> with_normals = estimator_->compute(cloud);
+    estimator_->compute(cloud, with_normals_);
     auto msg = boost::make_shared<sensor_msgs::PointCloud2>();
-    pcl::toROSMsg(with_normals, *msg);
+    pcl::toROSMsg(with_normals_, *msg);
     msg->header = image->header;
     cloud_pub_.publish(msg);
     diagnostics_->frameProcessed(
@@ -100,6 +100,8 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
 
   BackProjectionParams back_projection_;
   std::unique_ptr<NormalEstimator> estimator_;
+  // Output storage reused from frame to frame (a subscription's callbacks never run concurrently).
+  pcl::PointCloud<pcl::PointNormal> with_normals_;
   std::unique_ptr<NodeletDiagnostics> diagnostics_;
   std::mutex intrinsics_mutex_;
   CameraIntrinsics intrinsics_;

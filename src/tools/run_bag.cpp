@@ -172,6 +172,7 @@ int main(int argc, char** argv) {
     double last_stamp = -1e300;
     const auto start = std::chrono::steady_clock::now();
     qs::RgbdFrame frame;
+    pcl::PointCloud<pcl::PointNormal> cloud;  // storage reused from frame to frame
     while (frames < total && timer.time("read", [&] { return source->next(frame); })) {
       ++frames;
       if (frame.stamp <= last_stamp) {
@@ -188,8 +189,8 @@ int main(int argc, char** argv) {
         ++skipped;
         continue;
       }
-      const pcl::PointCloud<pcl::PointNormal> cloud = timer.time("normals", [&] {
-        return normals.compute(qs::backProject(qs::depthViewOf(frame.depth_m), k, back_projection));
+      timer.time("normals", [&] {
+        normals.compute(qs::backProject(qs::depthViewOf(frame.depth_m), k, back_projection), cloud);
       });
       if (!o.odometry_only) {
         const qs::Segmentation segmentation =
