@@ -1,0 +1,71 @@
+// Reconstruction of the map's surfaces (the paper's Section V, Figs. 1 and 5): the supporting
+// points of a landmark's observations, drawn projected onto the landmark's current surface
+// estimate.
+//
+// Points are stored in the landmark's own quadric frame (as estimated when they were added), one
+// per voxel of that frame, so memory is bounded by the observed area rather than by the number of
+// frames, and a landmark whose estimate moves carries its points with it: cloud() places every
+// point with the current T_map_quadric and projects it onto the current surface
+// (geometry/surface_distance.h).
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
+#include <unordered_set>
+#include <vector>
+
+#include "quadric_slam/geometry/quadric.h"
+#include "quadric_slam/geometry/surface_distance.h"
+
+namespace quadric_slam {
+
+class QuadricReconstruction {
+ public:
+  struct Params {
+    double voxel_size = 0.01;              // m: at most one point per voxel of a quadric frame, > 0
+    int max_points_per_landmark = 100000;  // further points of a landmark are dropped, >= 1
+    double max_surface_distance = 0.05;    // m: points farther from the surface are outliers, > 0
+    void validate() const;  // throws std::invalid_argument naming the field and its range
+  };
+
+  QuadricReconstruction();
+  explicit QuadricReconstruction(const Params& params);
+
+  // Adds the supporting points (camera frame) of landmark `id` seen from T_map_camera, given the
+  // landmark's current estimate in the map frame. Points that are not finite, or farther than
+  // max_surface_distance from the surface (exact distance for the classes of revolution and planes,
+  // first-order for general quadrics), are skipped, as are points in an occupied voxel. Returns how
+  // many points were stored.
+  int addPoints(int id, const QuadricModel& landmark_map, const Eigen::Isometry3d& T_map_camera,
+                const std::vector<Eigen::Vector3f>& points_camera);
+
+  void removeLandmark(int id);
+  void clear();
+
+  std::size_t size() const;        // points stored over all landmarks
+  std::size_t size(int id) const;  // points stored for one landmark (0 when unknown)
+
+  // The stored points of every landmark in `landmarks_map` (id -> current estimate, map frame),
+  // placed with that estimate and projected onto its surface, labelled with the landmark id.
+  // Landmarks without points, and points whose projection fails (a general quadric far from
+  // convergence), are left out.
+  pcl::PointCloud<pcl::PointXYZL> cloud(const std::map<int, QuadricModel>& landmarks_map) const;
+
+ private:
+  struct LandmarkPoints {
+    std::unordered_set<std::uint64_t> voxels;  // packed integer voxel coordinates
+    std::vector<Eigen::Vector3f> points_quadric;
+  };
+  std::uint64_t voxelKey(const Eigen::Vector3d& p_quadric) const;
+
+  Params params_;
+  SurfaceProjector projector_;
+  std::map<int, LandmarkPoints> landmarks_;
+};
+
+}  // namespace quadric_slam

@@ -1,0 +1,112 @@
+#include "quadric_slam/mapping/reconstruction.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace quadric_slam {
+
+void QuadricReconstruction::Params::validate() const {
+  if (!(voxel_size > 0.0 && std::isfinite(voxel_size)))
+    throw std::invalid_argument("QuadricReconstruction::Params::voxel_size must be > 0 (m), got " +
+                                std::to_string(voxel_size));
+  if (max_points_per_landmark < 1)
+    throw std::invalid_argument(
+        "QuadricReconstruction::Params::max_points_per_landmark must be >= 1, got " +
+        std::to_string(max_points_per_landmark));
+  if (!(max_surface_distance > 0.0))
+    throw std::invalid_argument(
+        "QuadricReconstruction::Params::max_surface_distance must be > 0 (m), got " +
+        std::to_string(max_surface_distance));
+}
+
+QuadricReconstruction::QuadricReconstruction() : QuadricReconstruction(Params()) {}
+
+QuadricReconstruction::QuadricReconstruction(const Params& params) : params_(params) {
+  params_.validate();
+}
+
+std::uint64_t QuadricReconstruction::voxelKey(const Eigen::Vector3d& p_quadric) const {
+  // 21 bits per axis (two's complement, wrapped): unique within +-10 km at 1 cm voxels.
+  const auto axis = [&](double value) {
+    return static_cast<std::uint64_t>(
+               static_cast<std::int64_t>(std::floor(value / params_.voxel_size))) &
+           ((std::uint64_t{1} << 21) - 1);
+  };
+  return axis(p_quadric.x()) | axis(p_quadric.y()) << 21 | axis(p_quadric.z()) << 42;
+}
+
+int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
+                                     const Eigen::Isometry3d& T_map_camera,
+                                     const std::vector<Eigen::Vector3f>& points_camera) {
+  LandmarkPoints& stored = landmarks_[id];
+  const Eigen::Isometry3d T_quadric_camera = landmark_map.pose().inverse() * T_map_camera;
+  const bool exact = landmark_map.quadricClass() != QuadricClass::kGeneral;
+  int added = 0;
+  for (const Eigen::Vector3f& point : points_camera) {
+    if (static_cast<int>(stored.points_quadric.size()) >= params_.max_points_per_landmark)
+      break;
+    if (!point.allFinite())
+      continue;
+    const Eigen::Vector3d p_map = T_map_camera * point.cast<double>();
+    const double distance =
+        exact ? exactDistance(landmark_map, p_map) : firstOrderDistance(landmark_map, p_map);
+    if (!(distance <= params_.max_surface_distance))
+      continue;
+    const Eigen::Vector3d p_quadric = T_quadric_camera * point.cast<double>();
+    if (!stored.voxels.insert(voxelKey(p_quadric)).second)
+      continue;
+    stored.points_quadric.push_back(p_quadric.cast<float>());
+    ++added;
+  }
+  if (stored.points_quadric.empty())
+    landmarks_.erase(id);
+  return added;
+}
+
+void QuadricReconstruction::removeLandmark(int id) {
+  landmarks_.erase(id);
+}
+
+void QuadricReconstruction::clear() {
+  landmarks_.clear();
+}
+
+std::size_t QuadricReconstruction::size() const {
+  std::size_t total = 0;
+  for (const auto& [id, stored] : landmarks_)
+    total += stored.points_quadric.size();
+  return total;
+}
+
+std::size_t QuadricReconstruction::size(int id) const {
+  const auto it = landmarks_.find(id);
+  return it == landmarks_.end() ? 0 : it->second.points_quadric.size();
+}
+
+pcl::PointCloud<pcl::PointXYZL> QuadricReconstruction::cloud(
+    const std::map<int, QuadricModel>& landmarks_map) const {
+  pcl::PointCloud<pcl::PointXYZL> out;
+  for (const auto& [id, landmark] : landmarks_map) {
+    const auto stored = landmarks_.find(id);
+    if (stored == landmarks_.end())
+      continue;
+    for (const Eigen::Vector3f& p_quadric : stored->second.points_quadric) {
+      Eigen::Vector3d on_surface;
+      try {
+        on_surface = projector_.project(landmark, landmark.pose() * p_quadric.cast<double>());
+      } catch (const std::invalid_argument&) {
+        continue;  // a general quadric whose projection does not converge from here
+      }
+      pcl::PointXYZL point;
+      point.x = static_cast<float>(on_surface.x());
+      point.y = static_cast<float>(on_surface.y());
+      point.z = static_cast<float>(on_surface.z());
+      point.label = static_cast<std::uint32_t>(id);
+      out.push_back(point);
+    }
+  }
+  return out;
+}
+
+}  // namespace quadric_slam
