@@ -14,6 +14,7 @@
 #include <random>
 #include <vector>
 
+#include "../real_frames.h"
 #include "quadric_slam/frontend/box_gradient_normals.h"
 #include "quadric_slam/frontend/frame.h"
 
@@ -27,28 +28,6 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 // length differs from 1 by ~1e-7, which acos turns into ~0.03 deg).
 double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::atan2(a.cross(b).norm(), a.dot(b)) * kRadToDeg;
-}
-
-pcl::PointCloud<pcl::PointXYZ> realFrame() {
-  const std::filesystem::path file = std::filesystem::path(QUADRIC_SLAM_SHARED_DATA_DIR) /
-                                     "tum_frames/fr3_long_office_household/1341847980.723020.png";
-  const cv::Mat raw = cv::imread(file.string(), cv::IMREAD_ANYDEPTH);
-  if (raw.empty() || raw.type() != CV_16UC1)
-    return {};
-  qs::CameraIntrinsics k;  // Freiburg3 (shared/data/README.md)
-  k.fx = 535.4;
-  k.fy = 539.2;
-  k.cx = 320.1;
-  k.cy = 247.6;
-  k.width = raw.cols;
-  k.height = raw.rows;
-  qs::DepthImageView<std::uint16_t> view;
-  view.data = raw.data;
-  view.width = raw.cols;
-  view.height = raw.rows;
-  view.row_step_bytes = raw.step;
-  view.metres_per_unit = 1.0 / 5000.0;
-  return qs::backProject(view, k, {});
 }
 
 // The estimator's rules, written out without any of its speed-ups.
@@ -146,7 +125,7 @@ bool bitwiseEqual(const pcl::PointCloud<pcl::PointNormal>& a,
 }  // namespace
 
 TEST(BoxGradientNormals, AgreesWithTheReferenceOnARealFrame) {
-  const auto cloud = realFrame();
+  const auto cloud = qs::test::fr3HouseholdCloud();
   if (cloud.empty())
     GTEST_SKIP() << "real TUM frame not found";
   qs::BoxGradientSettings settings;
@@ -184,7 +163,7 @@ TEST(BoxGradientNormals, AgreesWithTheReferenceOnARealFrame) {
 }
 
 TEST(BoxGradientNormals, EveryThreadCountGivesTheSameCloud) {
-  const auto cloud = realFrame();
+  const auto cloud = qs::test::fr3HouseholdCloud();
   if (cloud.empty())
     GTEST_SKIP() << "real TUM frame not found";
   for (int stride : {1, 2, 3}) {
@@ -204,7 +183,7 @@ TEST(BoxGradientNormals, EveryThreadCountGivesTheSameCloud) {
 }
 
 TEST(BoxGradientNormals, ReusedOutputIsFullyOverwritten) {
-  const auto cloud = realFrame();
+  const auto cloud = qs::test::fr3HouseholdCloud();
   if (cloud.empty())
     GTEST_SKIP() << "real TUM frame not found";
   const qs::BoxGradientSettings settings;

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "../real_frames.h"
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 
@@ -340,28 +341,10 @@ RegionCheck checkRegion(const pcl::PointCloud<pcl::PointNormal>& cloud, int u0, 
 }  // namespace
 
 TEST(NormalEstimator, RealTumFrameDeskTopAndFloorAgreeWithPlaneFit) {
-  const std::filesystem::path file = std::filesystem::path(QUADRIC_SLAM_SHARED_DATA_DIR) /
-                                     "tum_frames/fr3_long_office_household/1341847980.723020.png";
-  if (!std::filesystem::exists(file))
-    GTEST_SKIP() << "real TUM frame not found at " << file;
-  const cv::Mat raw = cv::imread(file.string(), cv::IMREAD_ANYDEPTH);
-  ASSERT_EQ(raw.type(), CV_16UC1);
-  ASSERT_EQ(raw.cols, 640);
-
-  qs::CameraIntrinsics k;  // Freiburg3 (shared/data/README.md)
-  k.fx = 535.4;
-  k.fy = 539.2;
-  k.cx = 320.1;
-  k.cy = 247.6;
-  k.width = raw.cols;
-  k.height = raw.rows;
-  qs::DepthImageView<std::uint16_t> view;
-  view.data = raw.data;
-  view.width = raw.cols;
-  view.height = raw.rows;
-  view.row_step_bytes = raw.step;
-  view.metres_per_unit = 1.0 / 5000.0;  // TUM PNG depth
-  const auto cloud = qs::NormalEstimator({}).compute(qs::backProject(view, k, {}));
+  const auto points = qs::test::fr3HouseholdCloud();
+  if (points.empty())
+    GTEST_SKIP() << "real TUM frame not found in " << QUADRIC_SLAM_SHARED_DATA_DIR;
+  const auto cloud = qs::NormalEstimator({}).compute(points);
 
   // Desk top left of the dice (in the depth image, which is offset from the colour image: columns
   // left of 55 there see the far background), and a floor strip between the chairs.
