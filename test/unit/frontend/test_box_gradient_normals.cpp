@@ -5,12 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <random>
 #include <vector>
 

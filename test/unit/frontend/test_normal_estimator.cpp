@@ -3,12 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
-#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <filesystem>
 #include <stdexcept>
 #include <vector>
 
