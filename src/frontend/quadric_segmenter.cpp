@@ -269,6 +269,45 @@ PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
   return cone;
 }
 
+// Least share of neighbouring points (4-neighbours on the grid) on which the general quadric's
+// gradient must take the same side of the measured normal for the quadric to be a surface through
+// the points: about 1 on a real surface (a single sheet, or two that meet along a line such as a
+// dihedral edge), about 1/2 when two close sheets split the noise band point by point.
+constexpr double kMinSheetCoherence = 0.75;
+
+// Whether the general quadric is a surface through the points rather than a fit of their noise
+// band: neighbouring points lie on the same sheet (see kMinSheetCoherence).
+bool generalQuadricIsSurface(const GeneralQuadricFit& general, const Frame& frame,
+                             const std::vector<int>& indices, const ImageRoi& roi) {
+  // Side of the measured normal the gradient takes, per pixel of the roi: 0 none, 1, 2.
+  std::vector<std::uint8_t> side(static_cast<std::size_t>(roi.width) * roi.height, 0);
+  for (int i : indices) {
+    const pcl::PointNormal& q = frame.cloud.points[i];
+    const double c = general.gradientDirection(pointOf(q)).dot(normalOf(q));
+    const int x = i % frame.width - roi.x_offset, y = i / frame.width - roi.y_offset;
+    side[static_cast<std::size_t>(y) * roi.width + x] = c > 0 ? 1 : c < 0 ? 2 : 0;
+  }
+  int same = 0, pairs = 0;
+  for (int y = 0; y < roi.height; ++y) {
+    for (int x = 0; x < roi.width; ++x) {
+      const std::uint8_t s = side[static_cast<std::size_t>(y) * roi.width + x];
+      if (s == 0)
+        continue;
+      for (const std::uint8_t t :
+           {x + 1 < roi.width ? side[static_cast<std::size_t>(y) * roi.width + x + 1]
+                              : std::uint8_t(0),
+            y + 1 < roi.height ? side[static_cast<std::size_t>(y + 1) * roi.width + x]
+                               : std::uint8_t(0)}) {
+        if (t == 0)
+          continue;
+        ++pairs;
+        same += s == t;
+      }
+    }
+  }
+  return pairs > 0 && same >= kMinSheetCoherence * pairs;
+}
+
 bool plausible(const PrimitiveShape& s, const QuadricSegmenter::Params& p) {
   if (!s.point.allFinite() || !s.direction.allFinite() || !std::isfinite(s.size))
     return false;
@@ -458,7 +497,26 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     const std::vector<Eigen::Vector3d> points(sample_points.begin() + first, sample_points.end());
     const std::vector<Eigen::Vector3d> normals(sample_normals.begin() + first,
                                                sample_normals.end());
-    for (CgalShapeDetector::Shape& shape : CgalShapeDetector(cgal).detect(points, normals)) {
+    std::vector<CgalShapeDetector::Shape> shapes = CgalShapeDetector(cgal).detect(points, normals);
+    // CGAL's planes only absorb flat patches. A plane on points whose normals bend (curvature above
+    // the grower's max_curvature) is a curved surface whose sag the depth noise hides (a far,
+    // narrow strip of a cylinder fits a plane within epsilon): look again without planes.
+    const bool curved_plane =
+        std::any_of(shapes.begin(), shapes.end(), [&](const CgalShapeDetector::Shape& shape) {
+          if (shape.shape.quadric_class != QuadricClass::kPlane)
+            return false;
+          std::vector<int> pixels;
+          pixels.reserve(shape.indices.size());
+          for (int k : shape.indices)
+            pixels.push_back(sample_pixel[first + k]);
+          return patchCurvature(cloud, pixels, shape.shape.direction) > p.planes.max_curvature;
+        });
+    if (curved_plane) {
+      CgalShapeDetector::Params curved = cgal;
+      curved.planes = false;
+      shapes = CgalShapeDetector(curved).detect(points, normals);
+    }
+    for (CgalShapeDetector::Shape& shape : shapes) {
       for (int& k : shape.indices)
         k += static_cast<int>(first);
       candidates.push_back(std::move(shape));
@@ -537,18 +595,28 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     if (indices.empty() || !plausible(fit.shape, p))
       continue;
     const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
-    // Degeneracy: a near-flat surface is a plane, not a curved primitive.
-    const double plane_rms = rmsDistance(fitPlane(points), points);
-    if (plane_rms < p.plane_rms_ratio * fit.rms)
+    // Degeneracy: a near-flat surface is a plane, not a curved primitive. Flat means what it means
+    // to the plane region grower: the plane fits almost as well AND the normals do not bend (shape
+    // operator at most the grower's max_curvature). The normals decide when the depth noise hides
+    // the sag (a far cylinder seen over a narrow arc); without them such a surface would be
+    // neither a plane (the grower rejects it as curved) nor a curved primitive.
+    const PrimitiveShape plane = fitPlane(points);
+    if (rmsDistance(plane, points) < p.plane_rms_ratio * fit.rms &&
+        patchCurvature(cloud, indices, plane.direction) <= p.planes.max_curvature)
       continue;
     const double z = medianDepth(cloud, indices);
     if (fit.rms >
         p.max_rms_factor * depthThreshold(z, p.planes.distance_factor, p.planes.min_distance))
       continue;
     // Shape test: residuals well above a general quadric's are shape (e.g. an ellipsoid), not
-    // noise.
+    // noise. Only when the general quadric is a surface through the points: when the depth noise
+    // is large against the patch's curvature (a far, narrow strip of a cylinder), its 10
+    // coefficients fit the noise band instead, with two close sheets that split neighbouring
+    // points, and its RMS drops well below the noise that any true surface leaves.
     const GeneralQuadricFit general = fitGeneralQuadric(points);
-    if (general.ok && fit.rms > p.quadric_rms_ratio * general.rms)
+    const bool general_is_surface =
+        general.ok && generalQuadricIsSurface(general, frame, indices, roiOf(indices, width));
+    if (general_is_surface && fit.rms > p.quadric_rms_ratio * general.rms)
       continue;
     accept(fit.shape, indices, fit);
   }
