@@ -269,6 +269,66 @@ PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
   return cone;
 }
 
+// A cylinder of the given curvature (1/radius) from points and their normals: the normals are
+// perpendicular to the axis (the least-variance direction of the normals, uncentred), and the axis
+// runs through p -+ r n (the sign that gathers these feet best: normals towards the camera point
+// out of a cylinder's outside and into its inside). Radius 0 when degenerate.
+PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
+                                   const std::vector<Eigen::Vector3d>& normals, double curvature) {
+  PrimitiveShape cylinder =
+      PrimitiveShape::cylinder(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0);
+  if (points.size() < 10 || points.size() != normals.size() || !(curvature > 0))
+    return cylinder;
+  Eigen::Matrix3d N = Eigen::Matrix3d::Zero();
+  for (const auto& n : normals)
+    N += n * n.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(N);
+  if (eig.info() != Eigen::Success)
+    return cylinder;
+  const Eigen::Vector3d axis = eig.eigenvectors().col(0);
+  const double radius = 1.0 / curvature;
+  double best_scatter = std::numeric_limits<double>::max();
+  for (const double sign : {-1.0, 1.0}) {
+    // Feet on the axis, projected onto the plane perpendicular to it.
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    double sum_sq = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      Eigen::Vector3d foot = points[i] + sign * radius * normals[i];
+      foot -= axis.dot(foot) * axis;
+      mean += foot;
+      sum_sq += foot.squaredNorm();
+    }
+    mean /= static_cast<double>(points.size());
+    const double scatter = sum_sq / static_cast<double>(points.size()) - mean.squaredNorm();
+    if (scatter < best_scatter) {
+      best_scatter = scatter;
+      cylinder = PrimitiveShape::cylinder(mean, axis, radius);
+    }
+  }
+  return cylinder;
+}
+
+// The largest principal curvature of a curved shape over its support (1/m): 1/r for a sphere or
+// cylinder, cos(half angle) / (distance to the axis) for a cone (mean over the points).
+double shapeCurvature(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
+  if (shape.quadric_class != QuadricClass::kCone)
+    return shape.size > 0 ? 1.0 / shape.size : 0.0;
+  double sum = 0;
+  for (const auto& q : points) {
+    const Eigen::Vector3d v = q - shape.point;
+    sum += std::cos(shape.size) /
+           std::max((v - shape.direction.dot(v) * shape.direction).norm(), 1e-3);
+  }
+  return points.empty() ? 0.0 : sum / static_cast<double>(points.size());
+}
+
+// Whether the measured normals bend like the shape: curvature (patchCurvature of the support) above
+// the plane grower's flatness limit and within a factor of 2 of the shape's own curvature.
+bool normalsBendLike(double curvature, double shape_curvature, const QuadricSegmenter::Params& p) {
+  return curvature > p.planes.max_curvature && curvature > 0.5 * shape_curvature &&
+         curvature < 2.0 * shape_curvature;
+}
+
 // Least share of neighbouring points (4-neighbours on the grid) on which the general quadric's
 // gradient must take the same side of the measured normal for the quadric to be a surface through
 // the points: about 1 on a real surface (a single sheet, or two that meet along a line such as a
@@ -500,21 +560,27 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     std::vector<CgalShapeDetector::Shape> shapes = CgalShapeDetector(cgal).detect(points, normals);
     // CGAL's planes only absorb flat patches. A plane on points whose normals bend (curvature above
     // the grower's max_curvature) is a curved surface whose sag the depth noise hides (a far,
-    // narrow strip of a cylinder fits a plane within epsilon): look again without planes.
-    const bool curved_plane =
-        std::any_of(shapes.begin(), shapes.end(), [&](const CgalShapeDetector::Shape& shape) {
-          if (shape.shape.quadric_class != QuadricClass::kPlane)
-            return false;
-          std::vector<int> pixels;
-          pixels.reserve(shape.indices.size());
-          for (int k : shape.indices)
-            pixels.push_back(sample_pixel[first + k]);
-          return patchCurvature(cloud, pixels, shape.shape.direction) > p.planes.max_curvature;
-        });
-    if (curved_plane) {
-      CgalShapeDetector::Params curved = cgal;
-      curved.planes = false;
-      shapes = CgalShapeDetector(curved).detect(points, normals);
+    // narrow strip of a cylinder fits a plane within epsilon): it becomes a cylinder candidate
+    // fitted to the normals (model selection may turn it into a cone or sphere).
+    for (CgalShapeDetector::Shape& shape : shapes) {
+      if (shape.shape.quadric_class != QuadricClass::kPlane)
+        continue;
+      std::vector<int> pixels;
+      std::vector<Eigen::Vector3d> support, support_normals;
+      for (int k : shape.indices) {
+        pixels.push_back(sample_pixel[first + k]);
+        support.push_back(points[k]);
+        support_normals.push_back(normals[k]);
+      }
+      const double curvature = patchCurvature(cloud, pixels, shape.shape.direction);
+      if (curvature <= p.planes.max_curvature)
+        continue;
+      // The cylinder the normals describe must fit the points better than the plane does (not so
+      // on clutter, which stays absorbed by the plane).
+      const PrimitiveShape cylinder = cylinderFromNormals(support, support_normals, curvature);
+      if (plausible(cylinder, p) &&
+          rmsDistance(cylinder, support) < rmsDistance(shape.shape, support))
+        shape.shape = cylinder;
     }
     for (CgalShapeDetector::Shape& shape : shapes) {
       for (int& k : shape.indices)
@@ -602,7 +668,8 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     // neither a plane (the grower rejects it as curved) nor a curved primitive.
     const PrimitiveShape plane = fitPlane(points);
     if (rmsDistance(plane, points) < p.plane_rms_ratio * fit.rms &&
-        patchCurvature(cloud, indices, plane.direction) <= p.planes.max_curvature)
+        !normalsBendLike(patchCurvature(cloud, indices, plane.direction),
+                         shapeCurvature(fit.shape, points), p))
       continue;
     const double z = medianDepth(cloud, indices);
     if (fit.rms >
