@@ -63,7 +63,8 @@ struct Frame {
 };
 
 // Pixels of the frame's free points inside roi that lie within the distance threshold of shape
-// and whose normal agrees; the largest 4-connected component of them.
+// and whose normal agrees; the largest 4-connected component of them, with the large components on
+// the surface's other face.
 std::vector<int> assignLargestComponent(const Frame& frame, const PrimitiveShape& shape,
                                         const ImageRoi& roi, const QuadricSegmenter::Params& p) {
   const double cos_angle = std::cos(p.curved_max_normal_angle);
@@ -85,6 +86,7 @@ std::vector<int> assignLargestComponent(const Frame& frame, const PrimitiveShape
     }
   }
   std::vector<int> best, component, stack;
+  std::vector<std::vector<int>> large;  // components of at least min_curved_points
   std::vector<std::uint8_t> seen(candidate.size(), 0);
   for (int start = 0; start < static_cast<int>(candidate.size()); ++start) {
     if (!candidate[start] || seen[start])
@@ -110,8 +112,33 @@ std::vector<int> assignLargestComponent(const Frame& frame, const PrimitiveShape
         stack.push_back(m);
       }
     }
+    if (static_cast<int>(component.size()) >= p.min_curved_points)
+      large.push_back(component);
     if (component.size() > best.size())
       best.swap(component);
+  }
+  // The other face of an open surface joins: an open cylinder's outer wall and, over the rim, its
+  // inner wall are separate components (a depth jump at the rim) whose measured normals, turned
+  // to the camera, point out of and into the surface. Components on the same face as the largest
+  // (a neighbouring object of the same size and pose) do not.
+  const auto outward = [&](const std::vector<int>& indices) {
+    int out = 0;
+    for (int i : indices) {
+      const pcl::PointNormal& q = frame.cloud.points[i];
+      out += shape.normalAt(pointOf(q)).dot(normalOf(q)) > 0;
+    }
+    return 2 * out > static_cast<int>(indices.size());
+  };
+  if (large.size() > 1) {
+    const auto largest =
+        std::max_element(large.begin(), large.end(),
+                         [](const auto& a, const auto& b) { return a.size() < b.size(); });
+    const bool largest_outward = outward(*largest);
+    std::vector<int> joined = *largest;
+    for (auto other = large.begin(); other != large.end(); ++other)
+      if (other != largest && outward(*other) != largest_outward)
+        joined.insert(joined.end(), other->begin(), other->end());
+    return joined;
   }
   return best;
 }
@@ -681,9 +708,8 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     // coefficients fit the noise band instead, with two close sheets that split neighbouring
     // points, and its RMS drops well below the noise that any true surface leaves.
     const GeneralQuadricFit general = fitGeneralQuadric(points);
-    const bool general_is_surface =
-        general.ok && generalQuadricIsSurface(general, frame, indices, roiOf(indices, width));
-    if (general_is_surface && fit.rms > p.quadric_rms_ratio * general.rms)
+    if (general.ok && fit.rms > p.quadric_rms_ratio * general.rms &&
+        generalQuadricIsSurface(general, frame, indices, roiOf(indices, width)))
       continue;
     accept(fit.shape, indices, fit);
   }
