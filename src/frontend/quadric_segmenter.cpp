@@ -340,11 +340,11 @@ PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
 double shapeCurvature(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
   if (shape.quadric_class != QuadricClass::kCone)
     return shape.size > 0 ? 1.0 / shape.size : 0.0;
+  const double cos_half_angle = std::cos(shape.size);
   double sum = 0;
   for (const auto& q : points) {
     const Eigen::Vector3d v = q - shape.point;
-    sum += std::cos(shape.size) /
-           std::max((v - shape.direction.dot(v) * shape.direction).norm(), 1e-3);
+    sum += cos_half_angle / std::max((v - shape.direction.dot(v) * shape.direction).norm(), 1e-3);
   }
   return points.empty() ? 0.0 : sum / static_cast<double>(points.size());
 }
