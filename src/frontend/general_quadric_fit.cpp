@@ -44,6 +44,13 @@ double GeneralQuadricFit::distance(const Eigen::Vector3d& p) const {
   return spread * sampson(coefficients, (p - centre) / spread);
 }
 
+Eigen::Vector3d GeneralQuadricFit::gradientDirection(const Eigen::Vector3d& p) const {
+  Eigen::Vector3d g;
+  value(coefficients, (p - centre) / spread, &g);
+  const double norm = g.norm();
+  return norm > 0 ? Eigen::Vector3d(g / norm) : Eigen::Vector3d::Zero();
+}
+
 GeneralQuadricFit fitGeneralQuadric(const std::vector<Eigen::Vector3d>& all_points, int max_points,
                                     int iterations) {
   GeneralQuadricFit fit;

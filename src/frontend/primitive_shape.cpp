@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "quadric_slam/geometry/shapes.h"
 
@@ -188,7 +189,14 @@ PrimitiveShape perturb(const PrimitiveShape& shape, const Eigen::VectorXd& delta
     throw std::invalid_argument("perturb: delta has the wrong dimension for the class");
   }
   // pi [+] dpi = (T exp(xi), S + D(s)) in the quadric frame (eqs. 9, 11, 16; Table II basis).
-  return PrimitiveShape::fromQuadric(shape.quadric().plusMinimal(delta));
+  const QuadricModel moved = shape.quadric().plusMinimal(delta);
+  // The core's [+] adds the scale step unchecked: a step through alpha = 0 leaves a quadric with a
+  // scale <= 0 (which QuadricModel's constructor rejects), read back as a negative radius or a
+  // cone half angle beyond pi/2, a shape whose distance() is another surface.
+  if (!(moved.scale().minCoeff() > 0) || !moved.scale().allFinite())
+    throw std::invalid_argument("perturb: the step leaves the class (scale " +
+                                std::to_string(moved.scale().minCoeff()) + " <= 0)");
+  return PrimitiveShape::fromQuadric(moved);
 }
 
 }  // namespace quadric_slam

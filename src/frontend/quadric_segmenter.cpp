@@ -63,7 +63,8 @@ struct Frame {
 };
 
 // Pixels of the frame's free points inside roi that lie within the distance threshold of shape
-// and whose normal agrees; the largest 4-connected component of them.
+// and whose normal agrees; the largest 4-connected component of them, with the large components on
+// the surface's other face.
 std::vector<int> assignLargestComponent(const Frame& frame, const PrimitiveShape& shape,
                                         const ImageRoi& roi, const QuadricSegmenter::Params& p) {
   const double cos_angle = std::cos(p.curved_max_normal_angle);
@@ -85,6 +86,7 @@ std::vector<int> assignLargestComponent(const Frame& frame, const PrimitiveShape
     }
   }
   std::vector<int> best, component, stack;
+  std::vector<std::vector<int>> large;  // components of at least min_curved_points
   std::vector<std::uint8_t> seen(candidate.size(), 0);
   for (int start = 0; start < static_cast<int>(candidate.size()); ++start) {
     if (!candidate[start] || seen[start])
@@ -110,8 +112,33 @@ std::vector<int> assignLargestComponent(const Frame& frame, const PrimitiveShape
         stack.push_back(m);
       }
     }
+    if (static_cast<int>(component.size()) >= p.min_curved_points)
+      large.push_back(component);
     if (component.size() > best.size())
       best.swap(component);
+  }
+  // The other face of an open surface joins: an open cylinder's outer wall and, over the rim, its
+  // inner wall are separate components (a depth jump at the rim) whose measured normals, turned
+  // to the camera, point out of and into the surface. Components on the same face as the largest
+  // (a neighbouring object of the same size and pose) do not.
+  const auto outward = [&](const std::vector<int>& indices) {
+    int out = 0;
+    for (int i : indices) {
+      const pcl::PointNormal& q = frame.cloud.points[i];
+      out += shape.normalAt(pointOf(q)).dot(normalOf(q)) > 0;
+    }
+    return 2 * out > static_cast<int>(indices.size());
+  };
+  if (large.size() > 1) {
+    const auto largest =
+        std::max_element(large.begin(), large.end(),
+                         [](const auto& a, const auto& b) { return a.size() < b.size(); });
+    const bool largest_outward = outward(*largest);
+    std::vector<int> joined = *largest;
+    for (auto other = large.begin(); other != large.end(); ++other)
+      if (other != largest && outward(*other) != largest_outward)
+        joined.insert(joined.end(), other->begin(), other->end());
+    return joined;
   }
   return best;
 }
@@ -267,6 +294,105 @@ PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
   cone.direction = axis;
   cone.size = angle / static_cast<double>(points.size());
   return cone;
+}
+
+// A cylinder of the given curvature (1/radius) from points and their normals: the normals are
+// perpendicular to the axis (the least-variance direction of the normals, uncentred), and the axis
+// runs through p -+ r n (the sign that gathers these feet best: normals towards the camera point
+// out of a cylinder's outside and into its inside). Radius 0 when degenerate.
+PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
+                                   const std::vector<Eigen::Vector3d>& normals, double curvature) {
+  PrimitiveShape cylinder =
+      PrimitiveShape::cylinder(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0);
+  if (points.size() < 10 || points.size() != normals.size() || !(curvature > 0))
+    return cylinder;
+  Eigen::Matrix3d N = Eigen::Matrix3d::Zero();
+  for (const auto& n : normals)
+    N += n * n.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(N);
+  if (eig.info() != Eigen::Success)
+    return cylinder;
+  const Eigen::Vector3d axis = eig.eigenvectors().col(0);
+  const double radius = 1.0 / curvature;
+  double best_scatter = std::numeric_limits<double>::max();
+  for (const double sign : {-1.0, 1.0}) {
+    // Feet on the axis, projected onto the plane perpendicular to it.
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    double sum_sq = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      Eigen::Vector3d foot = points[i] + sign * radius * normals[i];
+      foot -= axis.dot(foot) * axis;
+      mean += foot;
+      sum_sq += foot.squaredNorm();
+    }
+    mean /= static_cast<double>(points.size());
+    const double scatter = sum_sq / static_cast<double>(points.size()) - mean.squaredNorm();
+    if (scatter < best_scatter) {
+      best_scatter = scatter;
+      cylinder = PrimitiveShape::cylinder(mean, axis, radius);
+    }
+  }
+  return cylinder;
+}
+
+// The largest principal curvature of a curved shape over its support (1/m): 1/r for a sphere or
+// cylinder, cos(half angle) / (distance to the axis) for a cone (mean over the points).
+double shapeCurvature(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
+  if (shape.quadric_class != QuadricClass::kCone)
+    return shape.size > 0 ? 1.0 / shape.size : 0.0;
+  const double cos_half_angle = std::cos(shape.size);
+  double sum = 0;
+  for (const auto& q : points) {
+    const Eigen::Vector3d v = q - shape.point;
+    sum += cos_half_angle / std::max((v - shape.direction.dot(v) * shape.direction).norm(), 1e-3);
+  }
+  return points.empty() ? 0.0 : sum / static_cast<double>(points.size());
+}
+
+// Whether the measured normals bend like the shape: curvature (patchCurvature of the support) above
+// the plane grower's flatness limit and within a factor of 2 of the shape's own curvature.
+bool normalsBendLike(double curvature, double shape_curvature, const QuadricSegmenter::Params& p) {
+  return curvature > p.planes.max_curvature && curvature > 0.5 * shape_curvature &&
+         curvature < 2.0 * shape_curvature;
+}
+
+// Least share of neighbouring points (4-neighbours on the grid) on which the general quadric's
+// gradient must take the same side of the measured normal for the quadric to be a surface through
+// the points: about 1 on a real surface (a single sheet, or two that meet along a line such as a
+// dihedral edge), about 1/2 when two close sheets split the noise band point by point.
+constexpr double kMinSheetCoherence = 0.75;
+
+// Whether the general quadric is a surface through the points rather than a fit of their noise
+// band: neighbouring points lie on the same sheet (see kMinSheetCoherence).
+bool generalQuadricIsSurface(const GeneralQuadricFit& general, const Frame& frame,
+                             const std::vector<int>& indices, const ImageRoi& roi) {
+  // Side of the measured normal the gradient takes, per pixel of the roi: 0 none, 1, 2.
+  std::vector<std::uint8_t> side(static_cast<std::size_t>(roi.width) * roi.height, 0);
+  for (int i : indices) {
+    const pcl::PointNormal& q = frame.cloud.points[i];
+    const double c = general.gradientDirection(pointOf(q)).dot(normalOf(q));
+    const int x = i % frame.width - roi.x_offset, y = i / frame.width - roi.y_offset;
+    side[static_cast<std::size_t>(y) * roi.width + x] = c > 0 ? 1 : c < 0 ? 2 : 0;
+  }
+  int same = 0, pairs = 0;
+  for (int y = 0; y < roi.height; ++y) {
+    for (int x = 0; x < roi.width; ++x) {
+      const std::uint8_t s = side[static_cast<std::size_t>(y) * roi.width + x];
+      if (s == 0)
+        continue;
+      for (const std::uint8_t t :
+           {x + 1 < roi.width ? side[static_cast<std::size_t>(y) * roi.width + x + 1]
+                              : std::uint8_t(0),
+            y + 1 < roi.height ? side[static_cast<std::size_t>(y + 1) * roi.width + x]
+                               : std::uint8_t(0)}) {
+        if (t == 0)
+          continue;
+        ++pairs;
+        same += s == t;
+      }
+    }
+  }
+  return pairs > 0 && same >= kMinSheetCoherence * pairs;
 }
 
 bool plausible(const PrimitiveShape& s, const QuadricSegmenter::Params& p) {
@@ -458,7 +584,32 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     const std::vector<Eigen::Vector3d> points(sample_points.begin() + first, sample_points.end());
     const std::vector<Eigen::Vector3d> normals(sample_normals.begin() + first,
                                                sample_normals.end());
-    for (CgalShapeDetector::Shape& shape : CgalShapeDetector(cgal).detect(points, normals)) {
+    std::vector<CgalShapeDetector::Shape> shapes = CgalShapeDetector(cgal).detect(points, normals);
+    // CGAL's planes only absorb flat patches. A plane on points whose normals bend (curvature above
+    // the grower's max_curvature) is a curved surface whose sag the depth noise hides (a far,
+    // narrow strip of a cylinder fits a plane within epsilon): it becomes a cylinder candidate
+    // fitted to the normals (model selection may turn it into a cone or sphere).
+    for (CgalShapeDetector::Shape& shape : shapes) {
+      if (shape.shape.quadric_class != QuadricClass::kPlane)
+        continue;
+      std::vector<int> pixels;
+      std::vector<Eigen::Vector3d> support, support_normals;
+      for (int k : shape.indices) {
+        pixels.push_back(sample_pixel[first + k]);
+        support.push_back(points[k]);
+        support_normals.push_back(normals[k]);
+      }
+      const double curvature = patchCurvature(cloud, pixels, shape.shape.direction);
+      if (curvature <= p.planes.max_curvature)
+        continue;
+      // The cylinder the normals describe must fit the points better than the plane does (not so
+      // on clutter, which stays absorbed by the plane).
+      const PrimitiveShape cylinder = cylinderFromNormals(support, support_normals, curvature);
+      if (plausible(cylinder, p) &&
+          rmsDistance(cylinder, support) < rmsDistance(shape.shape, support))
+        shape.shape = cylinder;
+    }
+    for (CgalShapeDetector::Shape& shape : shapes) {
       for (int& k : shape.indices)
         k += static_cast<int>(first);
       candidates.push_back(std::move(shape));
@@ -537,18 +688,28 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     if (indices.empty() || !plausible(fit.shape, p))
       continue;
     const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
-    // Degeneracy: a near-flat surface is a plane, not a curved primitive.
-    const double plane_rms = rmsDistance(fitPlane(points), points);
-    if (plane_rms < p.plane_rms_ratio * fit.rms)
+    // Degeneracy: a near-flat surface is a plane, not a curved primitive. Flat means what it means
+    // to the plane region grower: the plane fits almost as well AND the normals do not bend (shape
+    // operator at most the grower's max_curvature). The normals decide when the depth noise hides
+    // the sag (a far cylinder seen over a narrow arc); without them such a surface would be
+    // neither a plane (the grower rejects it as curved) nor a curved primitive.
+    const PrimitiveShape plane = fitPlane(points);
+    if (rmsDistance(plane, points) < p.plane_rms_ratio * fit.rms &&
+        !normalsBendLike(patchCurvature(cloud, indices, plane.direction),
+                         shapeCurvature(fit.shape, points), p))
       continue;
     const double z = medianDepth(cloud, indices);
     if (fit.rms >
         p.max_rms_factor * depthThreshold(z, p.planes.distance_factor, p.planes.min_distance))
       continue;
     // Shape test: residuals well above a general quadric's are shape (e.g. an ellipsoid), not
-    // noise.
+    // noise. Only when the general quadric is a surface through the points: when the depth noise
+    // is large against the patch's curvature (a far, narrow strip of a cylinder), its 10
+    // coefficients fit the noise band instead, with two close sheets that split neighbouring
+    // points, and its RMS drops well below the noise that any true surface leaves.
     const GeneralQuadricFit general = fitGeneralQuadric(points);
-    if (general.ok && fit.rms > p.quadric_rms_ratio * general.rms)
+    if (general.ok && fit.rms > p.quadric_rms_ratio * general.rms &&
+        generalQuadricIsSurface(general, frame, indices, roiOf(indices, width)))
       continue;
     accept(fit.shape, indices, fit);
   }

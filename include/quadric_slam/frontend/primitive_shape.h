@@ -69,7 +69,8 @@ struct PrimitiveShape {
 const std::vector<int>& minimalIndices(QuadricClass quadric_class);
 
 // pi [+] delta (eqs. 9-17) through the core: fromQuadric(shape.quadric().plusMinimal(delta)),
-// delta with minimalDimension(class) entries ordered as minimalIndices().
+// delta with minimalDimension(class) entries ordered as minimalIndices(). Throws
+// std::invalid_argument when the step leaves the class (a scale alpha driven to <= 0).
 PrimitiveShape perturb(const PrimitiveShape& shape, const Eigen::VectorXd& delta);
 
 }  // namespace quadric_slam

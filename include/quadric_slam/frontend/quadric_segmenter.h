@@ -6,12 +6,15 @@
 //  1. planes by region growing over the image grid (plane_region_grower.h), flatness-checked;
 //  2. CGAL Efficient RANSAC (Schnabel et al. 2007) with sphere, cylinder, cone (and plane, to
 //     absorb small planar patches) on a sub-sample of each image-grid connected component of
-//     the remaining points;
+//     the remaining points; a CGAL plane whose normals bend (the grower's curvature test) becomes
+//     the cylinder its normals describe when that fits better (a far, narrow strip of a cylinder);
 //  3. for each CGAL shape, biggest first: range and degeneracy filters (huge-radius cylinders,
 //     near-flat cones and big spheres are tested against a plane; thin cones against a
 //     cylinder), least-squares refinement, re-assignment of all free full-resolution pixels
-//     near the surface with agreeing normals, the largest image-grid connected component,
-//     minimum support, refinement again (shape_refiner.h).
+//     near the surface with agreeing normals, the largest image-grid connected component (with
+//     the large ones on the surface's other face: an open bin's inner wall), minimum support,
+//     refinement again (shape_refiner.h); near-flat (plane RMS close AND normals not bending
+//     like the shape) and shape (RMS against a general quadric that is a surface) tests.
 #pragma once
 
 #include <pcl/point_cloud.h>
@@ -102,7 +105,9 @@ class QuadricSegmenter {
     double min_cylinder_radius = 0.01, max_cylinder_radius = 0.5;
     double min_cone_half_angle = 0.05, max_cone_half_angle = 1.2;
     // Degeneracy: a curved fit whose RMS is not clearly better than a plane's (plane RMS <
-    // plane_rms_ratio * curved RMS) is a plane; a cone or cylinder whose RMS is not clearly
+    // plane_rms_ratio * curved RMS) is a plane, unless its normals bend like it (shape operator
+    // above the plane grower's max_curvature, within a factor 2 of the shape's curvature: the
+    // depth noise hides the sag of a far, narrow arc); a cone or cylinder whose RMS is not clearly
     // better than that of a simpler class (cone -> cylinder -> sphere; RMS of the simpler <
     // cylinder_rms_ratio * its own) becomes the simpler class. Ratios >= 1.
     // A cylinder is also fitted as a cone (a truncated cone with a small half angle looks like a
@@ -111,7 +116,9 @@ class QuadricSegmenter {
     double cylinder_rms_ratio = 1.15;
     // Shape test: a curved fit whose RMS exceeds quadric_rms_ratio times that of a general quadric
     // fitted to the same points (general_quadric_fit.h) has residuals of shape, not noise (e.g. a
-    // sphere on an ellipsoid) and is dropped. >= 1; default 1.3.
+    // sphere on an ellipsoid) and is dropped; not when the general quadric fits the noise band
+    // with two close sheets that split neighbouring points (under 3/4 of the grid neighbours on
+    // one sheet), which undercuts any true surface's RMS. >= 1; default 1.3.
     double quadric_rms_ratio = 1.3;
     // Largest fit RMS of a curved segment, relative to its distance threshold at the median
     // depth, (0, 10].

@@ -201,3 +201,28 @@ TEST(ShapeRefiner, AShapeWithoutACoreQuadricIsNotRefinedAndDoesNotThrow) {
   EXPECT_FALSE(refiner.refine(bad, points).ok);
   EXPECT_FALSE(refiner.evaluate(bad, points).ok);
 }
+
+TEST(PrimitiveShape, PerturbThrowsWhenTheScaleStepLeavesTheClass) {
+  // The core's [+] adds the scale step unchecked; a step through alpha = 0 used to come back as a
+  // cylinder of negative radius or a cone with a half angle beyond pi/2 (no core quadric), and the
+  // refiner's next Jacobian threw from perturb() outside its guarded step (a real frame aborted
+  // bench_segmentation).
+  const PrimitiveShape cylinder =
+      PrimitiveShape::cylinder(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d::UnitY(), 0.1);
+  Eigen::VectorXd step = Eigen::VectorXd::Zero(5);
+  step[4] = -20;  // alpha = 1 / r: 10 -> -10
+  EXPECT_THROW(perturb(cylinder, step), std::invalid_argument);
+  step[4] = -5;  // 10 -> 5: radius 0.2
+  EXPECT_NEAR(perturb(cylinder, step).size, 0.2, 1e-12);
+
+  const PrimitiveShape cone =
+      PrimitiveShape::cone(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d::UnitZ(), 1.0);
+  Eigen::VectorXd cone_step = Eigen::VectorXd::Zero(6);
+  cone_step[5] = -1.0;  // alpha = 1 / tan(1.0) = 0.64 -> -0.36
+  EXPECT_THROW(perturb(cone, cone_step), std::invalid_argument);
+
+  const PrimitiveShape sphere = PrimitiveShape::sphere(Eigen::Vector3d(0, 0, 1), 0.1);
+  Eigen::VectorXd sphere_step = Eigen::VectorXd::Zero(4);
+  sphere_step[3] = -10;  // alpha 10 -> 0
+  EXPECT_THROW(perturb(sphere, sphere_step), std::invalid_argument);
+}
