@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "quadric_slam/frontend/boundary_labels.h"
 #include "quadric_slam/frontend/cgal_shape_detector.h"
 #include "quadric_slam/frontend/general_quadric_fit.h"
 #include "quadric_slam/geometry/symmetry.h"
@@ -434,6 +435,8 @@ void QuadricSegmenter::Params::validate() const {
               str(min_range) + ", " + str(max_range));
   require(decimation >= 1 && decimation <= 8,
           "decimation must be in [1, 8], got " + std::to_string(decimation));
+  require(boundary_rings >= 0 && boundary_rings <= 10,
+          "boundary_rings must be in [0, 10], got " + std::to_string(boundary_rings));
   planes.validate();
   refiner.validate();
   require(cgal_stride >= 1 && cgal_stride <= 16,
@@ -828,6 +831,21 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
 }  // namespace
 
 Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& cloud) const {
+  Segmentation result = segmentWithNormals(cloud);
+  const auto start = std::chrono::steady_clock::now();
+  BoundaryCompletion boundary;
+  boundary.rings = params_.boundary_rings;
+  boundary.min_range = params_.min_range;
+  boundary.max_range = params_.max_range;
+  boundary.distance_factor = params_.planes.distance_factor;
+  boundary.min_distance = params_.planes.min_distance;
+  completeBoundaryLabels(cloud, boundary, result);
+  result.timings.boundary_ms = msSince(start);
+  return result;
+}
+
+Segmentation QuadricSegmenter::segmentWithNormals(
+    const pcl::PointCloud<pcl::PointNormal>& cloud) const {
   if (!cloud.isOrganized() && !cloud.empty())
     throw std::invalid_argument("QuadricSegmenter: the cloud must be organized");
   const int d = params_.decimation;

@@ -54,6 +54,7 @@ struct SegmentationTimings {
   double ransac_ms = 0.0;     // sub-sampling and CGAL Efficient RANSAC
   double verify_ms = 0.0;     // filters, refinement and re-assignment of curved candidates
   double upsample_ms = 0.0;   // decimation and full-resolution labelling (decimation > 1)
+  double boundary_ms = 0.0;   // labels of boundary points without normals (boundary_labels.h)
   int ransac_points = 0;      // points given to CGAL
   int ransac_candidates = 0;  // shapes CGAL returned
 };
@@ -75,6 +76,10 @@ class QuadricSegmenter {
     // below are scaled accordingly) and the labels are then assigned at full resolution: each
     // pixel takes a neighbouring sample's label when it fits that surface. [1, 8]. Default 2.
     int decimation = 2;
+    // Points with depth but without a normal (next to depth edges and holes) join an adjacent
+    // segment whose surface they fit, up to this many pixels out (frontend/boundary_labels.h),
+    // [0, 10]; 0 = off. Default 3.
+    int boundary_rings = 3;
     // Planes (region growing); its min_points is in points of the cloud grid.
     PlaneRegionGrower::Params planes;
     // Curved shapes.
@@ -140,6 +145,9 @@ class QuadricSegmenter {
   const Params& params() const { return params_; }
 
  private:
+  // segment() without the boundary completion.
+  Segmentation segmentWithNormals(const pcl::PointCloud<pcl::PointNormal>& cloud) const;
+
   Params params_;
 };
 
