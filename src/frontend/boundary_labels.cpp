@@ -22,52 +22,66 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
   // Labels of detections only (defensive: a label without a detection is never spread).
   const auto owner = [&](std::uint16_t label) { return label >= 1 && label <= n ? label : 0; };
 
-  std::vector<int> candidates;  // pixels with depth, without a normal, unlabelled
+  // Pixels that may still join: depth in range, no normal, unlabelled.
+  std::vector<std::uint8_t> open(cloud.size(), 0);
   for (int v = 0; v < height; ++v) {
+    const std::uint16_t* label_row = labels.ptr<std::uint16_t>(v);
     for (int u = 0; u < width; ++u) {
-      const pcl::PointNormal& q = cloud(u, v);
-      if (labels.at<std::uint16_t>(v, u) == 0 && std::isfinite(q.x) && std::isfinite(q.y) &&
-          std::isfinite(q.z) && q.z >= settings.min_range && q.z <= settings.max_range &&
-          !std::isfinite(q.normal_x))
-        candidates.push_back(v * width + u);
+      const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
+      open[static_cast<std::size_t>(v) * width + u] =
+          label_row[u] == 0 && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+          q.z >= settings.min_range && q.z <= settings.max_range && !std::isfinite(q.normal_x);
     }
   }
-  for (int ring = 0; ring < settings.rings && !candidates.empty(); ++ring) {
+  // The first front: open pixels next to a labelled one; later fronts: open pixels next to a pixel
+  // that joined in the previous ring (so the work follows the rim, not the image).
+  const auto forEachNeighbour = [&](int index, auto fn) {
+    const int u = index % width, v = index / width;
+    for (int dv = -1; dv <= 1; ++dv) {
+      for (int du = -1; du <= 1; ++du) {
+        const int nu = u + du, nv = v + dv;
+        if ((du != 0 || dv != 0) && nu >= 0 && nv >= 0 && nu < width && nv < height)
+          fn(nv * width + nu, nu, nv);
+      }
+    }
+  };
+  std::vector<int> front;
+  for (int index = 0; index < static_cast<int>(cloud.size()); ++index) {
+    if (!open[index])
+      continue;
+    bool next_to_label = false;
+    forEachNeighbour(index, [&](int, int nu, int nv) {
+      next_to_label = next_to_label || owner(labels.at<std::uint16_t>(nv, nu)) != 0;
+    });
+    if (next_to_label)
+      front.push_back(index);
+  }
+  for (int ring = 0; ring < settings.rings && !front.empty(); ++ring) {
     // Each ring reads the labels of the previous one only, so growth is one pixel per ring.
     std::vector<std::pair<int, std::uint16_t>> joined;
-    std::vector<int> remaining;
-    for (const int index : candidates) {
-      const int u = index % width, v = index / width;
+    for (const int index : front) {
       const pcl::PointNormal& q = cloud.points[index];
       const Eigen::Vector3d point(q.x, q.y, q.z);
       double best_distance = depthThreshold(q.z, settings.distance_factor, settings.min_distance);
       std::uint16_t best = 0;
-      for (int dv = -1; dv <= 1; ++dv) {
-        for (int du = -1; du <= 1; ++du) {
-          const int nu = u + du, nv = v + dv;
-          if ((du == 0 && dv == 0) || nu < 0 || nv < 0 || nu >= width || nv >= height)
-            continue;
-          const std::uint16_t label = owner(labels.at<std::uint16_t>(nv, nu));
-          if (label == 0 || label == best)
-            continue;
-          const double distance =
-              std::abs(segmentation.detections[label - 1].shape.distance(point));
-          if (distance < best_distance) {
-            best_distance = distance;
-            best = label;
-          }
+      forEachNeighbour(index, [&](int, int nu, int nv) {
+        const std::uint16_t label = owner(labels.at<std::uint16_t>(nv, nu));
+        if (label == 0 || label == best)
+          return;
+        const double distance = std::abs(segmentation.detections[label - 1].shape.distance(point));
+        if (distance < best_distance) {
+          best_distance = distance;
+          best = label;
         }
-      }
+      });
       if (best != 0)
         joined.emplace_back(index, best);
-      else
-        remaining.push_back(index);
     }
-    if (joined.empty())
-      break;
+    std::vector<int> next_front;
     for (const auto& [index, label] : joined) {
       const int u = index % width, v = index / width;
       labels.at<std::uint16_t>(v, u) = label;
+      open[index] = 0;
       QuadricDetection& detection = segmentation.detections[label - 1];
       ++detection.num_points;
       const pcl::PointNormal& q = cloud.points[index];
@@ -82,7 +96,17 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
       roi.width = x1 - roi.x_offset + 1;
       roi.height = y1 - roi.y_offset + 1;
     }
-    candidates.swap(remaining);
+    for (const auto& [index, label] : joined) {
+      forEachNeighbour(index, [&](int neighbour, int, int) {
+        if (open[neighbour] == 1) {
+          open[neighbour] = 2;  // queued once
+          next_front.push_back(neighbour);
+        }
+      });
+    }
+    for (const int index : next_front)
+      open[index] = 1;
+    front.swap(next_front);
   }
 }
 

@@ -201,7 +201,8 @@ int main(int argc, char** argv) {
   std::printf("frames: %zu real (%s), %zu synthetic; %d repeats each\n", real.size(), data.c_str(),
               synth.size(), repeats);
 
-  std::vector<double> real_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms, upsample_ms;
+  std::vector<double> real_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms, upsample_ms,
+      boundary_ms;
   for (int r = 0; r < repeats; ++r) {
     for (const auto* set : {&real, &synth}) {
       for (const Frame& f : *set) {
@@ -214,6 +215,7 @@ int main(int argc, char** argv) {
         ransac_ms.push_back(s.timings.ransac_ms);
         verify_ms.push_back(s.timings.verify_ms);
         upsample_ms.push_back(s.timings.upsample_ms);
+        boundary_ms.push_back(s.timings.boundary_ms);
       }
     }
   }
@@ -240,6 +242,7 @@ int main(int argc, char** argv) {
   report("    stage: ransac", ransac_ms);
   report("    stage: verification", verify_ms);
   report("    stage: upsampling", upsample_ms);
+  report("    stage: boundary", boundary_ms);
   std::printf("Baseline, CGAL Efficient RANSAC, 4 shapes, full frame (%zu shapes total):\n",
               base_shapes);
   report("  baseline frames", base_ms);
