@@ -2,19 +2,16 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
-#include <boost/math/distributions/chi_squared.hpp>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
-#include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/geometry/quadric_classes.h"
-#include "quadric_slam/mapping/factors.h"
+#include "quadric_slam/mapping/observation_linearization.h"
 
 namespace quadric_slam {
 
 namespace {
-
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 void requireRange(bool ok, const char* field, const char* range) {
   if (!ok)
@@ -46,7 +43,35 @@ Eigen::MatrixXd floorCovariance(const QuadricAssociator::Params& p, const Quadri
   return floor;
 }
 
+// Regularised lower incomplete gamma P(a, x) by its power series (converges for every x > 0; the
+// gates need x < ~200).
+double gammaP(double a, double x) {
+  if (x <= 0.0)
+    return 0.0;
+  double term = 1.0 / a, sum = term;
+  for (int n = 1; n < 100000 && term > sum * 1e-16; ++n) {
+    term *= x / (a + n);
+    sum += term;
+  }
+  return std::min(1.0, std::exp(-x + a * std::log(x) - std::lgamma(a)) * sum);
+}
+
 }  // namespace
+
+// Bisection on the chi-square CDF P(k/2, x/2). (boost::math's inverse returns NaN for most k under
+// the -frounding-math that CGAL requires, so the project computes its own.)
+double chiSquareQuantile(int degrees_of_freedom, double probability) {
+  if (degrees_of_freedom < 1 || !(probability > 0.0 && probability < 1.0))
+    throw std::invalid_argument("chiSquareQuantile: needs k >= 1 and probability in (0, 1)");
+  double lo = 0.0, hi = 1.0;
+  while (gammaP(0.5 * degrees_of_freedom, 0.5 * hi) < probability)
+    hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (gammaP(0.5 * degrees_of_freedom, 0.5 * mid) < probability ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
 
 bool sameKind(const QuadricModel& a, const QuadricModel& b) {
   if (a.quadricClass() != b.quadricClass())
@@ -67,8 +92,7 @@ void QuadricAssociator::Params::validate() const {
 QuadricAssociator::QuadricAssociator(const Params& params) : params_(params) {
   params_.validate();
   for (QuadricClass c : kAllQuadricClasses) {
-    const boost::math::chi_squared distribution(minimalDimension(c));
-    gates_[static_cast<int>(c)] = boost::math::quantile(distribution, params_.gate_probability);
+    gates_[static_cast<int>(c)] = chiSquareQuantile(minimalDimension(c), params_.gate_probability);
   }
 }
 
@@ -91,23 +115,12 @@ double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
       (target.covariance.rows() != k || target.covariance.cols() != k))
     throw std::invalid_argument("QuadricAssociator: target covariance is not k x k");
 
-  // Unwhitened residual (L = I) and its ambient Jacobians.
-  const QuadricObservationCost cost(z, Eigen::MatrixXd::Identity(k, k));
-  std::array<double, kPoseParameterSize> pose;
-  std::array<double, kQuadricParameterSize> quadric;
-  poseToParameters(T_map_camera, pose.data());
-  quadricToParameters(target.quadric_map, quadric.data());
-  const double* blocks[2] = {pose.data(), quadric.data()};
-  Eigen::VectorXd r0(k);
-  RowMajor J_pose(k, kPoseParameterSize), J_quadric(k, kQuadricParameterSize);
-  double* jacobians[2] = {J_pose.data(), J_quadric.data()};
-  if (!cost.Evaluate(blocks, r0.data(), jacobians) || !r0.allFinite())
+  const ObservationLinearization lin = linearizeObservation(z, T_map_camera, target.quadric_map);
+  if (!lin.valid)
     return std::numeric_limits<double>::infinity();
-  const Eigen::MatrixXd J_c = J_pose * posePlusJacobian(pose.data());
-  const QuadricManifold manifold(c);
-  RowMajor plus_q(kQuadricParameterSize, k);
-  manifold.PlusJacobian(quadric.data(), plus_q.data());
-  const Eigen::MatrixXd J_q = J_quadric * plus_q;
+  const Eigen::VectorXd& r0 = lin.residual;
+  const Eigen::MatrixXd& J_c = lin.J_camera;
+  const Eigen::MatrixXd& J_q = lin.J_quadric;
 
   Matrix6d P = pose_covariance;
   const double st = params_.pose_translation_sigma, sr = params_.pose_rotation_sigma;

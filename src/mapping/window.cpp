@@ -10,6 +10,7 @@
 
 #include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/mapping/factors.h"
+#include "quadric_slam/mapping/observation_linearization.h"
 
 namespace quadric_slam {
 
@@ -40,33 +41,51 @@ SlidingWindow::SlidingWindow(const Params& params) : params_(params) {
   params_.validate();
 }
 
-void SlidingWindow::enterLandmark(int landmark_id, const QuadricMap& map) {
-  const QuadricLandmark& landmark = map.landmark(landmark_id);
-  if (landmark.covariance.size() != 0)
-    priors_[landmark_id] = {landmark.quadric_map,
-                            params_.landmark_prior_inflation * landmark.covariance};
+void SlidingWindow::countObservation(int landmark_id) {
+  ++observation_counts_[landmark_id];
 }
 
-void SlidingWindow::countObservation(int landmark_id, const QuadricMap& map) {
-  int& count = observation_counts_[landmark_id];
-  if (count == 0)
-    enterLandmark(landmark_id, map);
-  ++count;
+void SlidingWindow::foldIntoPrior(const Keyframe& keyframe, const WindowObservation& observation,
+                                  const QuadricMap& map) {
+  const QuadricModel& landmark = map.landmark(observation.landmark_id).quadric_map;
+  const ObservationLinearization lin =
+      linearizeObservation(observation.measurement.quadric_camera, keyframe.T_map_camera, landmark);
+  if (!lin.valid)
+    return;
+  // The leaving pose is uncertain by the oldest-pose prior: S = Sigma_z + J_c P J_c^T.
+  const double st = params_.oldest_pose_translation_sigma;
+  const double sr = params_.oldest_pose_rotation_sigma;
+  const Vector6d p_diagonal =
+      (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr).finished();
+  Eigen::MatrixXd S = observation.measurement.covariance +
+                      lin.J_camera * p_diagonal.asDiagonal() * lin.J_camera.transpose();
+  S = 0.5 * (S + S.transpose()).eval();
+  const Eigen::LLT<Eigen::MatrixXd> llt(S);
+  if (llt.info() != Eigen::Success)
+    return;
+  const Eigen::MatrixXd information = lin.J_quadric.transpose() * llt.solve(lin.J_quadric);
+  if (!information.allFinite())
+    return;
+  LandmarkPrior& prior = priors_[observation.landmark_id];
+  // Mean: the landmark's current estimate; information: the sum (both in its minimal tangent).
+  prior.quadric_map = landmark;
+  if (prior.information.size() == 0)
+    prior.information = Eigen::MatrixXd::Zero(information.rows(), information.cols());
+  prior.information += 0.5 * (information + information.transpose());
 }
 
 void SlidingWindow::addKeyframe(Keyframe keyframe, const QuadricMap& map) {
   if (!any_keyframe_)
     any_keyframe_ = first_keyframe_in_window_ = true;
   for (const WindowObservation& observation : keyframe.observations)
-    countObservation(observation.landmark_id, map);
+    countObservation(observation.landmark_id);
   keyframes_.push_back(std::move(keyframe));
   while (static_cast<int>(keyframes_.size()) > params_.size) {
     for (const WindowObservation& observation : keyframes_.front().observations) {
+      foldIntoPrior(keyframes_.front(), observation, map);
       auto it = observation_counts_.find(observation.landmark_id);
-      if (--it->second == 0) {
+      if (--it->second == 0)
         observation_counts_.erase(it);
-        priors_.erase(observation.landmark_id);
-      }
     }
     keyframes_.pop_front();
     first_keyframe_in_window_ = false;
@@ -77,7 +96,8 @@ bool SlidingWindow::addObservation(int frame_index, const WindowObservation& obs
                                    const QuadricMap& map) {
   for (Keyframe& keyframe : keyframes_) {
     if (keyframe.frame_index == frame_index) {
-      countObservation(observation.landmark_id, map);
+      (void)map;
+      countObservation(observation.landmark_id);
       keyframe.observations.push_back(observation);
       return true;
     }
@@ -156,12 +176,20 @@ WindowStatistics SlidingWindow::optimize(QuadricMap* map) {
   for (const auto& [id, prior] : priors_) {
     if (landmarks.count(id) == 0)
       continue;
+    const Eigen::LLT<Eigen::MatrixXd> information(prior.information);
+    if (information.info() != Eigen::Success)
+      continue;
+    const Eigen::MatrixXd prior_covariance =
+        params_.landmark_prior_inflation * information.solve(Eigen::MatrixXd::Identity(
+                                               prior.information.rows(), prior.information.cols()));
     if (last_.landmark_priors == 0) {
       problem.AddParameterBlock(identity.data(), kPoseParameterSize, &pose_manifold);
       problem.SetParameterBlockConstant(identity.data());
     }
-    problem.AddResidualBlock(QuadricObservationCost::Create(prior.quadric_map, prior.covariance),
-                             nullptr, identity.data(), landmarks.at(id).data());
+    problem.AddResidualBlock(
+        QuadricObservationCost::Create(prior.quadric_map,
+                                       0.5 * (prior_covariance + prior_covariance.transpose())),
+        nullptr, identity.data(), landmarks.at(id).data());
     ++last_.landmark_priors;
   }
 

@@ -106,6 +106,10 @@ class QuadricAssociator {
   std::array<double, 5> gates_{};
 };
 
+// The chi-square quantile: x with P(chi2_k <= x) = probability. Throws std::invalid_argument for
+// k < 1 or a probability outside (0, 1).
+double chiSquareQuantile(int degrees_of_freedom, double probability);
+
 // True when a measurement may be compared with a target: same class, and for kGeneral the same
 // signature.
 bool sameKind(const QuadricModel& a, const QuadricModel& b);

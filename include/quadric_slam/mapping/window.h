@@ -6,10 +6,15 @@
 //     QuadricObservationCost per observation (eqs. 20-22),
 //   - the gauge: while the map's first keyframe is in the window it is held fixed (it defines the
 //     map frame); afterwards the oldest window pose gets a PosePriorCost at its current estimate,
-//   - for a landmark re-entering the window with a known marginal covariance (from an earlier stay
-//     in the window), a prior at its estimate on entry with that covariance (times
-//     landmark_prior_inflation): the information of the keyframes that left, summarised. The prior
-//     is QuadricObservationCost of the landmark's map-frame quadric from a constant identity pose.
+//   - for each landmark that was observed from keyframes that have left the window, a prior
+//     summarising those observations: when a keyframe leaves, each of its observations is
+//     linearised at the current estimates and its information J_q^T S^-1 J_q (S = Sigma_z +
+//     J_c P J_c^T, P the oldest-pose prior covariance: the leaving pose is taken as known to that
+//     accuracy) is added to the landmark's prior information; the prior's mean is the landmark's
+//     estimate at that moment. This keeps the history of a landmark that stays in view and gives
+//     a re-observed landmark (a loop) its earlier accuracy, at a cost of one k-dimensional factor
+//     per landmark. The prior is QuadricObservationCost of the prior quadric (map frame) from a
+//     constant identity pose, covariance landmark_prior_inflation * information^-1.
 // and solves it with a bounded number of iterations, so the cost per keyframe depends on the
 // window size and the landmarks in view, never on the sequence length. A keyframe leaving the
 // window takes its factors with it; a landmark no longer observed by any window keyframe leaves the
@@ -74,8 +79,9 @@ class SlidingWindow {
     // frame): m and rad, > 0.
     double oldest_pose_translation_sigma = 0.005;
     double oldest_pose_rotation_sigma = 0.002;
-    // Landmark priors on re-entry: covariance factor (>= 1) applied to the stored marginal.
-    double landmark_prior_inflation = 2.0;
+    // Landmark priors: factor (>= 1) on the folded covariance (the folding treats leaving poses
+    // as known to the oldest-pose prior's accuracy; inflate to be more conservative).
+    double landmark_prior_inflation = 1.0;
     // Compute the landmarks' marginal covariances after each optimisation.
     bool compute_covariance = true;
 
@@ -108,8 +114,9 @@ class SlidingWindow {
   const Params& params() const { return params_; }
 
  private:
-  void enterLandmark(int landmark_id, const QuadricMap& map);
-  void countObservation(int landmark_id, const QuadricMap& map);
+  void countObservation(int landmark_id);
+  void foldIntoPrior(const Keyframe& keyframe, const WindowObservation& observation,
+                     const QuadricMap& map);
 
   Params params_;
   std::deque<Keyframe> keyframes_;
@@ -117,10 +124,12 @@ class SlidingWindow {
   bool any_keyframe_ = false;
   std::map<int, int> observation_counts_;  // landmark id -> observations in the window
   struct LandmarkPrior {
-    QuadricModel quadric_map;
-    Eigen::MatrixXd covariance;
+    QuadricModel quadric_map;     // mean: the estimate when the latest observation was folded in
+    Eigen::MatrixXd information;  // k x k, minimal tangent
   };
-  std::map<int, LandmarkPrior> priors_;  // landmarks re-entering with a known covariance
+  // Landmarks whose observations from keyframes that left the window were folded in (one entry
+  // per landmark: grows with the map, not with the sequence).
+  std::map<int, LandmarkPrior> priors_;
   WindowStatistics last_;
 };
 

@@ -60,8 +60,10 @@ inline TrueLandmark cone(const Eigen::Vector3d& apex, const Eigen::Vector3d& axi
           {Eigen::Vector3d(-r, -r, 0.05), Eigen::Vector3d(r, r, length)}};
 }
 
-// A 10 x 10 m room, 3 m high: floor, four walls, two table tops at the same height (same infinite
-// plane, different places), three spheres, three cylinders (one horizontal), three cones.
+// A 10 x 10 m room, 3 m high: floor, four walls, two table tops 3 cm apart in height (inside each
+// other's association gate: only their extents tell them apart; not exactly equal so that the map
+// evaluator, which compares infinite planes, can tell which is which), three spheres, three
+// cylinders (one horizontal), three cones.
 inline std::vector<TrueLandmark> roomWorld() {
   const Eigen::Vector3d X = Eigen::Vector3d::UnitX(), Y = Eigen::Vector3d::UnitY(),
                         Z = Eigen::Vector3d::UnitZ();
@@ -72,13 +74,13 @@ inline std::vector<TrueLandmark> roomWorld() {
       plane(Eigen::Vector3d(0, 5, 1.5), -Y, X, 5, 1.5),
       plane(Eigen::Vector3d(0, -5, 1.5), Y, X, 5, 1.5),
       plane(Eigen::Vector3d(3.6, 1.2, 0.75), Z, X, 0.5, 0.4),
-      plane(Eigen::Vector3d(-3.6, -1.2, 0.75), Z, X, 0.5, 0.4),
+      plane(Eigen::Vector3d(-3.6, -1.2, 0.72), Z, X, 0.5, 0.4),
       sphere(Eigen::Vector3d(3.4, -1.6, 0.3), 0.3),
       sphere(Eigen::Vector3d(-1.2, 3.6, 0.25), 0.25),
       sphere(Eigen::Vector3d(0.8, -3.5, 1.0), 0.2),
       cylinder(Eigen::Vector3d(2.6, 3.0, 1.5), Z, 0.15, 1.5),
       cylinder(Eigen::Vector3d(-3.3, 2.2, 0.5), Z, 0.2, 0.5),
-      cylinder(Eigen::Vector3d(-1.0, -4.5, 2.2), X, 0.1, 1.5),
+      cylinder(Eigen::Vector3d(-1.0, -4.0, 0.5), X, 0.1, 1.0),
       cone(Eigen::Vector3d(3.5, -3.3, 0.7), -Z, 0.35, 0.6),
       cone(Eigen::Vector3d(-3.7, -1.0 + 2.5, 1.6), -Z, 0.4, 0.5),
       cone(Eigen::Vector3d(1.2, 3.8, 0.8), -Z, 0.3, 0.6),

@@ -50,6 +50,10 @@ TEST(QuadricAssociator, GateIsTheChiSquareQuantileOfTheMinimalDimension) {
   EXPECT_NEAR(associator.gate(QuadricClass::kCylinder), 20.515, 1e-3);
   EXPECT_NEAR(associator.gate(QuadricClass::kCone), 22.458, 1e-3);
   EXPECT_NEAR(associator.gate(QuadricClass::kGeneral), 27.877, 1e-3);
+  EXPECT_NEAR(chiSquareQuantile(1, 0.95), 3.8415, 1e-4);
+  EXPECT_NEAR(chiSquareQuantile(2, 0.99), 9.2103, 1e-4);
+  EXPECT_NEAR(chiSquareQuantile(9, 0.5), 8.3428, 1e-4);
+  EXPECT_THROW(chiSquareQuantile(0, 0.5), std::invalid_argument);
 }
 
 // Several landmarks of each class a few decimetres apart; each measurement (noise as stated in
