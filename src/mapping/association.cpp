@@ -87,6 +87,7 @@ void QuadricAssociator::Params::validate() const {
   requireRange(pose_translation_sigma >= 0.0, "pose_translation_sigma", "[0, inf) m");
   requireRange(pose_rotation_sigma >= 0.0, "pose_rotation_sigma", "[0, inf) rad");
   requireRange(extent_margin >= 0.0, "extent_margin", "[0, inf) m");
+  requireRange(max_range > 0.0, "max_range", "(0, inf) m");
 }
 
 QuadricAssociator::QuadricAssociator(const Params& params) : params_(params) {
@@ -145,13 +146,23 @@ std::vector<Association> QuadricAssociator::associate(
   };
   std::vector<Association> out(measurements.size());
   std::vector<Pair> acceptable;
+  // Targets near enough to be compared: distance from the camera centre to the extent box.
+  std::vector<bool> near(targets.size(), true);
+  for (size_t t = 0; t < targets.size(); ++t) {
+    const ExtentBox& box = targets[t].extent;
+    if (!box.known())
+      continue;
+    const Eigen::Vector3d c = targets[t].quadric_map.pose().inverse() * T_map_camera.translation();
+    const Eigen::Vector3d outside = (box.min - c).cwiseMax(c - box.max).cwiseMax(0.0);
+    near[t] = outside.norm() <= params_.max_range;
+  }
   for (size_t m = 0; m < measurements.size(); ++m) {
     const QuadricMeasurement& measurement = measurements[m];
     const ExtentBox observed{measurement.extent_min, measurement.extent_max};
     const Eigen::Isometry3d T_map_observed = T_map_camera * measurement.quadric_camera.pose();
     bool any_in_gate = false;
     for (size_t t = 0; t < targets.size(); ++t) {
-      if (!sameKind(measurement.quadric_camera, targets[t].quadric_map))
+      if (!near[t] || !sameKind(measurement.quadric_camera, targets[t].quadric_map))
         continue;
       const double d2 = squaredError(measurement, T_map_camera, pose_covariance, targets[t]);
       if (d2 < out[m].squared_error)

@@ -1,8 +1,10 @@
 // bench_mapping: per-frame cost of the mapping back-end (QuadricMapper) over a long synthetic run
-// (the room world of test/unit/mapping/synthetic_world.h, circling laps). Prints median and p95 of
+// (test/unit/mapping/synthetic_world.h: the room world, circling laps, or the corridor, whose map
+// grows with the distance travelled). Prints median and p95 of
 // association time (every frame) and window optimisation time (keyframes), for the whole run and
 // for its first and last fifths, with the window problem sizes: the cost must not grow with the
-// sequence. Usage: bench_mapping [--frames N (1000)] [--window K (10)] [--no-covariance]
+// sequence. Usage:
+//   bench_mapping [--frames N (1000)] [--window K (10)] [--world room|corridor] [--no-covariance]
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
@@ -36,6 +38,7 @@ void row(const std::string& name, const std::vector<double>& seconds) {
 int main(int argc, char** argv) {
   using namespace quadric_slam;
   int frames = 1000;
+  std::string world_name = "room";
   QuadricMapper::Params params;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -43,20 +46,26 @@ int main(int argc, char** argv) {
       frames = std::atoi(argv[++i]);
     } else if (arg == "--window" && i + 1 < argc) {
       params.window.size = std::atoi(argv[++i]);
+    } else if (arg == "--world" && i + 1 < argc) {
+      world_name = argv[++i];
     } else if (arg == "--no-covariance") {
       params.window.compute_covariance = false;
     } else {
-      std::cerr << "usage: bench_mapping [--frames N] [--window K] [--no-covariance]\n";
+      std::cerr << "usage: bench_mapping [--frames N] [--window K] [--world room|corridor] "
+                   "[--no-covariance]\n";
       return 2;
     }
   }
-  if (frames < 10) {
-    std::cerr << "bench_mapping: --frames must be >= 10\n";
+  if (frames < 10 || (world_name != "room" && world_name != "corridor")) {
+    std::cerr << "bench_mapping: --frames must be >= 10, --world room or corridor\n";
     return 2;
   }
   QuadricMapper mapper(params);
-  const std::vector<test::TrueLandmark> world = test::roomWorld();
-  const std::vector<Eigen::Isometry3d> poses = test::circleTrajectory(300, frames / 300.0);
+  const bool room = world_name == "room";
+  const std::vector<test::TrueLandmark> world =
+      room ? test::roomWorld() : test::corridorWorld(static_cast<int>(0.03 * frames) + 3);
+  const std::vector<Eigen::Isometry3d> poses =
+      room ? test::circleTrajectory(300, frames / 300.0) : test::corridorTrajectory(frames);
   std::mt19937 rng(1);
   const std::vector<Eigen::Isometry3d> odometry = test::driftingOdometry(poses, rng);
 
@@ -99,8 +108,8 @@ int main(int argc, char** argv) {
       max_residuals_late = std::max(max_residuals_late, r.window.residuals);
     }
   }
-  std::cout << "bench_mapping: " << n << " frames, " << keyframes << " keyframes, window "
-            << params.window.size << ", covariance "
+  std::cout << "bench_mapping: " << world_name << ", " << n << " frames, " << keyframes
+            << " keyframes, window " << params.window.size << ", covariance "
             << (params.window.compute_covariance ? "on" : "off") << ", landmarks "
             << mapper.map().landmarks().size() << "\n";
   row("association (all frames)", association_all);

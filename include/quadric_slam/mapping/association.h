@@ -43,7 +43,7 @@ struct AssociationTarget {
 
 enum class AssociationOutcome {
   kMatched,          // target_index names the match
-  kNoTargetOfClass,  // no target of the measurement's class (and signature, for kGeneral)
+  kNoTargetOfClass,  // no target of its class (and signature, for kGeneral) within max_range
   kOutsideGate,      // the best target's d^2 is above the gate
   kNoOverlap,        // targets inside the gate exist, but none whose extent overlaps
   kTakenByBetter,    // every acceptable target went to another measurement with a lower d^2
@@ -74,6 +74,10 @@ class QuadricAssociator {
     // Reject matches whose extents (grown by extent_margin, m, >= 0) do not overlap.
     bool check_extent = true;
     double extent_margin = 0.25;
+    // Targets whose (known) extent box is farther than this from the camera centre are not
+    // compared at all (m, > 0): keeps the per-frame cost to the landmarks around the camera as the
+    // map grows. Targets without a known extent are always compared.
+    double max_range = 10.0;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;

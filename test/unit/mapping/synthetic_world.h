@@ -87,6 +87,33 @@ inline std::vector<TrueLandmark> roomWorld() {
   };
 }
 
+// A corridor: a floor and a wall 30 m long and `objects` objects (spheres, cylinders, cones in
+// turn) one metre apart from x = 2 m on, alternately left and right. The map grows with the
+// distance travelled.
+inline std::vector<TrueLandmark> corridorWorld(int objects) {
+  const Eigen::Vector3d X = Eigen::Vector3d::UnitX(), Z = Eigen::Vector3d::UnitZ();
+  const double length = objects + 4.0;
+  std::vector<TrueLandmark> world = {
+      plane(Eigen::Vector3d(0.5 * length, 0, 0), Z, X, 0.5 * length + 1, 3),
+      plane(Eigen::Vector3d(0.5 * length, 2, 1.5), -Eigen::Vector3d::UnitY(), X, 0.5 * length + 1,
+            1.5)};
+  for (int j = 0; j < objects; ++j) {
+    const double x = 2.0 + j;
+    const double y = (j % 2 == 0) ? -0.8 : 1.0;
+    switch (j % 3) {
+      case 0:
+        world.push_back(sphere(Eigen::Vector3d(x, y, 0.25), 0.2 + 0.01 * (j % 5)));
+        break;
+      case 1:
+        world.push_back(cylinder(Eigen::Vector3d(x, y, 0.4), Z, 0.12, 0.4));
+        break;
+      default:
+        world.push_back(cone(Eigen::Vector3d(x, y, 0.6), -Z, 0.35, 0.5));
+    }
+  }
+  return world;
+}
+
 // Optical camera frame (x right, y down, z forward) at `position` looking along `forward`.
 inline Eigen::Isometry3d lookAlong(const Eigen::Vector3d& position,
                                    const Eigen::Vector3d& forward) {
@@ -110,6 +137,15 @@ inline std::vector<Eigen::Isometry3d> circleTrajectory(int frames_per_lap, doubl
                                   std::cos(0.3) * std::sin(heading), -std::sin(0.3));
     poses.push_back(lookAlong(p, forward));
   }
+  return poses;
+}
+
+// `frames` frames down the corridor at 3 cm per frame, weaving slightly.
+inline std::vector<Eigen::Isometry3d> corridorTrajectory(int frames) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < frames; ++i)
+    poses.push_back(lookAlong(Eigen::Vector3d(0.03 * i, 0.1 * std::sin(0.05 * i), 1.2),
+                              Eigen::Vector3d(1, 0.2 * std::sin(0.03 * i), -0.35)));
   return poses;
 }
 

@@ -34,6 +34,9 @@ TEST(QuadricAssociator, ParamsValidate) {
   p.floor_rotation_sigma = -1;
   EXPECT_THROW(QuadricAssociator{p}, std::invalid_argument);
   p = {};
+  p.max_range = 0;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = {};
   p.extent_margin = -0.1;
   try {
     p.validate();
@@ -195,6 +198,25 @@ TEST(QuadricAssociator, FloorAbsorbsPosePredictionError) {
   EXPECT_LT(d2_5deg_with_p, gate);
   // With the measurement at the truth and the true pose, d2 is ~0.
   EXPECT_LT(floored.squaredError(m, kTrueCamera, Matrix6d::Zero(), target(0, cylinder)), 1e-6);
+}
+
+// Landmarks beyond max_range (their boxes) are not even compared; targets of unknown extent are.
+TEST(QuadricAssociator, FarTargetsAreNotCompared) {
+  const test::TrueLandmark s = test::sphere(Eigen::Vector3d(0, 0, 0.3), 0.2);
+  std::mt19937 rng(13);
+  const QuadricMeasurement m = test::measure(s, kTrueCamera, rng);
+  QuadricAssociator::Params p;
+  p.max_range = 1.5;  // the sphere's box is ~2 m from the camera
+  std::vector<Association> a =
+      QuadricAssociator(p).associate({m}, kTrueCamera, Matrix6d::Zero(), {target(0, s)});
+  EXPECT_EQ(a[0].outcome, AssociationOutcome::kNoTargetOfClass);
+  AssociationTarget unknown_extent = target(0, s);
+  unknown_extent.extent = ExtentBox{};
+  a = QuadricAssociator(p).associate({m}, kTrueCamera, Matrix6d::Zero(), {unknown_extent});
+  EXPECT_EQ(a[0].outcome, AssociationOutcome::kMatched);
+  p.max_range = 3.0;
+  a = QuadricAssociator(p).associate({m}, kTrueCamera, Matrix6d::Zero(), {target(0, s)});
+  EXPECT_EQ(a[0].outcome, AssociationOutcome::kMatched);
 }
 
 TEST(QuadricAssociator, OneToOne) {

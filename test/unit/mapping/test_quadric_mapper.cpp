@@ -145,28 +145,8 @@ TEST(QuadricMapper, LoopBeatsOdometryAndLandmarksConverge) {
 // A corridor with a new object every metre: the map grows with the sequence, the window problem
 // does not.
 TEST(QuadricMapper, WindowProblemStaysBoundedWhileTheMapGrows) {
-  const Eigen::Vector3d X = Eigen::Vector3d::UnitX(), Z = Eigen::Vector3d::UnitZ();
-  std::vector<test::TrueLandmark> world = {
-      test::plane(Eigen::Vector3d(15, 0, 0), Z, X, 30, 3),
-      test::plane(Eigen::Vector3d(15, 2, 1.5), -Eigen::Vector3d::UnitY(), X, 30, 1.5)};
-  for (int j = 0; j < 30; ++j) {
-    const double x = 2.0 + j;
-    const double y = (j % 2 == 0) ? -0.8 : 1.0;
-    switch (j % 3) {
-      case 0:
-        world.push_back(test::sphere(Eigen::Vector3d(x, y, 0.25), 0.2 + 0.01 * (j % 5)));
-        break;
-      case 1:
-        world.push_back(test::cylinder(Eigen::Vector3d(x, y, 0.4), Z, 0.12, 0.4));
-        break;
-      default:
-        world.push_back(test::cone(Eigen::Vector3d(x, y, 0.6), -Z, 0.35, 0.5));
-    }
-  }
-  std::vector<Eigen::Isometry3d> poses;
-  for (int i = 0; i < 900; ++i)
-    poses.push_back(test::lookAlong(Eigen::Vector3d(0.03 * i, 0.1 * std::sin(0.05 * i), 1.2),
-                                    Eigen::Vector3d(1, 0.2 * std::sin(0.03 * i), -0.35)));
+  const std::vector<test::TrueLandmark> world = test::corridorWorld(30);
+  const std::vector<Eigen::Isometry3d> poses = test::corridorTrajectory(900);
   QuadricMapper::Params p;
   p.window.size = 8;
   QuadricMapper mapper(p);
