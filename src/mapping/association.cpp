@@ -137,6 +137,15 @@ double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
   return r0.dot(llt.solve(r0));
 }
 
+bool QuadricAssociator::inRange(const QuadricModel& quadric_map, const ExtentBox& extent,
+                                const Eigen::Isometry3d& T_map_camera) const {
+  if (!extent.known())
+    return true;
+  const Eigen::Vector3d c = quadric_map.pose().inverse() * T_map_camera.translation();
+  const Eigen::Vector3d outside = (extent.min - c).cwiseMax(c - extent.max).cwiseMax(0.0);
+  return outside.norm() <= params_.max_range;
+}
+
 std::vector<Association> QuadricAssociator::associate(
     const std::vector<QuadricMeasurement>& measurements, const Eigen::Isometry3d& T_map_camera,
     const Matrix6d& pose_covariance, const std::vector<AssociationTarget>& targets) const {
@@ -148,14 +157,8 @@ std::vector<Association> QuadricAssociator::associate(
   std::vector<Pair> acceptable;
   // Targets near enough to be compared: distance from the camera centre to the extent box.
   std::vector<bool> near(targets.size(), true);
-  for (size_t t = 0; t < targets.size(); ++t) {
-    const ExtentBox& box = targets[t].extent;
-    if (!box.known())
-      continue;
-    const Eigen::Vector3d c = targets[t].quadric_map.pose().inverse() * T_map_camera.translation();
-    const Eigen::Vector3d outside = (box.min - c).cwiseMax(c - box.max).cwiseMax(0.0);
-    near[t] = outside.norm() <= params_.max_range;
-  }
+  for (size_t t = 0; t < targets.size(); ++t)
+    near[t] = inRange(targets[t].quadric_map, targets[t].extent, T_map_camera);
   for (size_t m = 0; m < measurements.size(); ++m) {
     const QuadricMeasurement& measurement = measurements[m];
     const ExtentBox observed{measurement.extent_min, measurement.extent_max};

@@ -57,7 +57,11 @@ MapUpdate QuadricMap::integrate(int frame_index, double stamp,
   std::vector<AssociationTarget> targets;
   std::vector<int> target_ids;
   for (const auto& [id, landmark] : landmarks_) {
-    targets.push_back({id, landmark.quadric_map, landmark.covariance, landmarkExtent(landmark)});
+    // Landmarks far from the camera are not even copied (bounded per-frame work).
+    const ExtentBox extent = landmarkExtent(landmark);
+    if (!associator_.inRange(landmark.quadric_map, extent, T_map_camera))
+      continue;
+    targets.push_back({id, landmark.quadric_map, landmark.covariance, extent});
     target_ids.push_back(id);
   }
   const std::vector<Association> to_landmarks =
@@ -82,9 +86,15 @@ MapUpdate QuadricMap::integrate(int frame_index, double stamp,
 
   // 2. The rest against the candidates; 3. what matches nothing starts a candidate.
   targets.clear();
-  for (const QuadricCandidate& candidate : candidates_)
+  std::vector<int> candidate_index;
+  for (size_t c = 0; c < candidates_.size(); ++c) {
+    const QuadricCandidate& candidate = candidates_[c];
+    if (!associator_.inRange(candidate.quadric_map, candidate.extent, T_map_camera))
+      continue;
     targets.push_back(
         {candidate.id, candidate.quadric_map, candidate.covariance, candidate.extent});
+    candidate_index.push_back(static_cast<int>(c));
+  }
   const std::vector<Association> to_candidates =
       associator_.associate(rest, T_map_camera, pose_covariance, targets);
   for (size_t r = 0; r < rest.size(); ++r) {
@@ -93,7 +103,7 @@ MapUpdate QuadricMap::integrate(int frame_index, double stamp,
     const ExtentBox observed = observedExtentIn(measurement, T_map_camera, moved);
     MeasurementResult& result = update.measurements[rest_index[r]];
     if (to_candidates[r].outcome == AssociationOutcome::kMatched) {
-      QuadricCandidate& candidate = candidates_[to_candidates[r].target_index];
+      QuadricCandidate& candidate = candidates_[candidate_index[to_candidates[r].target_index]];
       // The estimate follows the latest measurement, re-expressed by the member of its symmetry
       // orbit closest to the previous estimate (so the box frame barely turns); the covariance is
       // re-expressed with it (geometry/symmetry.h).

@@ -96,6 +96,11 @@ class QuadricAssociator {
   double squaredError(const QuadricMeasurement& measurement, const Eigen::Isometry3d& T_map_camera,
                       const Matrix6d& pose_covariance, const AssociationTarget& target) const;
 
+  // False when the box `extent` (in the frame of quadric_map) is known and farther than max_range
+  // from the camera centre: such a target is not compared (callers may skip building it).
+  bool inRange(const QuadricModel& quadric_map, const ExtentBox& extent,
+               const Eigen::Isometry3d& T_map_camera) const;
+
   // One association per measurement, one-to-one: all acceptable (gate and extent) pairs are taken
   // in order of increasing d^2. Classes never mix; general quadrics also need equal signatures.
   std::vector<Association> associate(const std::vector<QuadricMeasurement>& measurements,
