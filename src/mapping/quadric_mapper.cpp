@@ -194,7 +194,7 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
     for (size_t p = 0; p < result.update.promoted.size(); ++p) {
       for (const CandidateObservation& o : result.update.promoted_history[p]) {
         if (o.frame_index != frame_index_)
-          window_.addObservation(o.frame_index, {result.update.promoted[p], o.measurement}, map_);
+          window_.addObservation(o.frame_index, {result.update.promoted[p], o.measurement});
       }
     }
     result.window = window_.optimize(&map_);

@@ -92,11 +92,9 @@ void SlidingWindow::addKeyframe(Keyframe keyframe, const QuadricMap& map) {
   }
 }
 
-bool SlidingWindow::addObservation(int frame_index, const WindowObservation& observation,
-                                   const QuadricMap& map) {
+bool SlidingWindow::addObservation(int frame_index, const WindowObservation& observation) {
   for (Keyframe& keyframe : keyframes_) {
     if (keyframe.frame_index == frame_index) {
-      (void)map;
       countObservation(observation.landmark_id);
       keyframe.observations.push_back(observation);
       return true;

@@ -98,7 +98,7 @@ class SlidingWindow {
   void addKeyframe(Keyframe keyframe, const QuadricMap& map);
   // Adds an observation of a landmark to the window keyframe of frame `frame_index` (the earlier
   // frames of a just-promoted candidate). Returns false when that frame is not a window keyframe.
-  bool addObservation(int frame_index, const WindowObservation& observation, const QuadricMap& map);
+  bool addObservation(int frame_index, const WindowObservation& observation);
 
   // Optimises the window and writes the estimates back (keyframe poses here, landmarks into the
   // map). When the solver fails or a landmark's estimate becomes invalid, the old estimates stay.
