@@ -139,6 +139,27 @@ TEST(QuadricAssociator, ClassesNeverMix) {
                std::invalid_argument);
 }
 
+// General quadrics match only quadrics of the same signature (an ellipsoid is never a hyperboloid).
+TEST(QuadricAssociator, GeneralQuadricsNeedTheSameSignature) {
+  const Eigen::Isometry3d T = makeIsometry(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 0.5));
+  const QuadricModel ellipsoid(QuadricClass::kGeneral, T, Eigen::Vector3d(4, 3, 2),
+                               Eigen::Vector4d(1, 1, 1, -1));
+  const QuadricModel hyperboloid(QuadricClass::kGeneral, T, Eigen::Vector3d(4, 3, 2),
+                                 Eigen::Vector4d(1, 1, -1, -1));
+  QuadricMeasurement m;
+  m.quadric_camera = predictMeasurement(kTrueCamera, ellipsoid);
+  m.covariance = 1e-4 * Eigen::MatrixXd::Identity(9, 9);
+  const QuadricAssociator associator;
+  std::vector<Association> a = associator.associate(
+      {m}, kTrueCamera, Matrix6d::Zero(), {{0, hyperboloid, Eigen::MatrixXd(), ExtentBox{}}});
+  EXPECT_EQ(a[0].outcome, AssociationOutcome::kNoTargetOfClass);
+  a = associator.associate({m}, kTrueCamera, Matrix6d::Zero(),
+                           {{0, hyperboloid, Eigen::MatrixXd(), ExtentBox{}},
+                            {1, ellipsoid, Eigen::MatrixXd(), ExtentBox{}}});
+  EXPECT_EQ(a[0].target_index, 1);
+  EXPECT_LT(a[0].squared_error, 1e-6);
+}
+
 // Two table tops at the same height are one infinite plane; only the extents tell them apart.
 TEST(QuadricAssociator, ExtentSeparatesTwoTablesAtTheSameHeight) {
   const Eigen::Vector3d Z = Eigen::Vector3d::UnitZ(), X = Eigen::Vector3d::UnitX();
