@@ -1,0 +1,126 @@
+// Data association (the paper's Section IV, "Data association"): each observed quadric is matched
+// to the map quadric of the same class with the lowest error of the observation cost (eqs. 20-22)
+// at the predicted camera pose (the previous estimate composed with the latest odometry), accepted
+// under a chi-square gate for the class's minimal dimension k.
+//
+// The gate. With r0 the unwhitened residual of QuadricObservationCost (eq. 22 with L = I: the
+// measurement-frame minimal error) and J_c, J_q its Jacobians w.r.t. the camera and landmark
+// tangents, the error is the Mahalanobis distance under the innovation covariance
+//   S = Sigma_z + Sigma_floor + J_c P_c J_c^T + J_q P_q J_q^T,     d^2 = r0^T S^-1 r0,
+// gated at chi2_k(gate_probability). Sigma_z is the front-end's fit covariance: from thousands of
+// points it is tiny (sub-mm, sub-0.1 deg), so on its own a 1 deg pose error would fail every
+// gate. Hence (parameters below): P_c = the caller's prediction covariance (odometry since the last
+// optimised pose) plus a pose floor, which the camera Jacobian turns into the lever-arm-correct
+// error in each minimal entry (a rotation error moves a distant plane's offset more); P_q = the
+// landmark's marginal covariance when known; Sigma_floor = a model-error floor in the minimal space
+// (translation entries, rotation entries, and scale entries relative to the target's scale).
+//
+// Extents: a match must also let the observed box of supporting points (moved into the target's
+// quadric frame through the predicted pose) overlap the target's box, grown by extent_margin: a
+// second table top at the same height is the same infinite plane, but not the same surface.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <limits>
+#include <vector>
+
+#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/geometry/quadric.h"
+#include "quadric_slam/geometry/se3.h"
+#include "quadric_slam/mapping/extent_box.h"
+
+namespace quadric_slam {
+
+// Something a measurement can be associated with (a landmark or a candidate), in the map frame.
+struct AssociationTarget {
+  int id = 0;                  // landmark or candidate id (reported back, never interpreted)
+  QuadricModel quadric_map;    // T_map_quadric, S, class
+  Eigen::MatrixXd covariance;  // k x k in the class's minimal space at quadric_map, or empty
+  ExtentBox extent;            // box of supporting points in the target's quadric frame (m)
+};
+
+enum class AssociationOutcome {
+  kMatched,          // target_index names the match
+  kNoTargetOfClass,  // no target of its class (and signature, for kGeneral) within max_range
+  kOutsideGate,      // the best target's d^2 is above the gate
+  kNoOverlap,        // targets inside the gate exist, but none whose extent overlaps
+  kTakenByBetter,    // every acceptable target went to another measurement with a lower d^2
+};
+
+struct Association {
+  AssociationOutcome outcome = AssociationOutcome::kNoTargetOfClass;
+  int target_index = -1;                                           // into the targets, when matched
+  double squared_error = std::numeric_limits<double>::infinity();  // d^2 of the best target
+};
+
+class QuadricAssociator {
+ public:
+  struct Params {
+    // Chi-square probability of the gate, (0, 1): 0.999 accepts 99.9% of true matches.
+    double gate_probability = 0.999;
+    // Model-error floor Sigma_floor (1-sigma) on the translation entries of the minimal vector
+    // (m, >= 0), the rotation entries (rad, >= 0) and the scale entries as a fraction of the
+    // target's scale (>= 0).
+    double floor_translation_sigma = 0.02;
+    double floor_rotation_sigma = 0.02;
+    double floor_scale_fraction = 0.05;
+    // Floor of the predicted camera pose uncertainty P_c (1-sigma, body frame), added to the
+    // caller's prediction covariance: m and rad, >= 0. The defaults tolerate ~3 deg / 10 cm of
+    // pose error at the 99.9% gate.
+    double pose_translation_sigma = 0.03;
+    double pose_rotation_sigma = 0.02;
+    // Reject matches whose extents (grown by extent_margin, m, >= 0) do not overlap.
+    bool check_extent = true;
+    double extent_margin = 0.25;
+    // Targets whose (known) extent box is farther than this from the camera centre are not
+    // compared at all (m, > 0): keeps the per-frame cost to the landmarks around the camera as the
+    // map grows. Targets without a known extent are always compared.
+    double max_range = 10.0;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  QuadricAssociator() : QuadricAssociator(Params{}) {}
+  explicit QuadricAssociator(const Params& params);
+
+  // The gate chi2_k(gate_probability) for the class's minimal dimension k.
+  double gate(QuadricClass quadric_class) const;
+
+  // d^2 of a measurement against one target of the same class at T_map_camera, with
+  // pose_covariance the 6x6 prediction covariance of T_map_camera (body tangent [rho; phi]) to
+  // which the pose floor is added. Throws std::invalid_argument when the classes differ or a
+  // covariance has the wrong size or is not positive definite.
+  double squaredError(const QuadricMeasurement& measurement, const Eigen::Isometry3d& T_map_camera,
+                      const Matrix6d& pose_covariance, const AssociationTarget& target) const;
+
+  // False when the box `extent` (in the frame of quadric_map) is known and farther than max_range
+  // from the camera centre: such a target is not compared (callers may skip building it).
+  bool inRange(const QuadricModel& quadric_map, const ExtentBox& extent,
+               const Eigen::Isometry3d& T_map_camera) const;
+
+  // One association per measurement, one-to-one: all acceptable (gate and extent) pairs are taken
+  // in order of increasing d^2. Classes never mix; general quadrics also need equal signatures.
+  std::vector<Association> associate(const std::vector<QuadricMeasurement>& measurements,
+                                     const Eigen::Isometry3d& T_map_camera,
+                                     const Matrix6d& pose_covariance,
+                                     const std::vector<AssociationTarget>& targets) const;
+
+  const Params& params() const { return params_; }
+
+ private:
+  Params params_;
+  std::array<double, 5> gates_{};
+};
+
+// The chi-square quantile: x with P(chi2_k <= x) = probability. Throws std::invalid_argument for
+// k < 1 or a probability outside (0, 1).
+double chiSquareQuantile(int degrees_of_freedom, double probability);
+
+// True when a measurement may be compared with a target: same class, and for kGeneral the same
+// signature.
+bool sameKind(const QuadricModel& a, const QuadricModel& b);
+
+}  // namespace quadric_slam

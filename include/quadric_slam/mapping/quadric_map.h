@@ -1,0 +1,108 @@
+// The map's bookkeeping: landmarks and candidates (the paper's experimental system: "we require a
+// quadric to have been observed in 5 frames before it is added"). Each frame's measurements are
+// associated (mapping/association.h) first against the landmarks, the rest against the candidates;
+// a measurement matching neither starts a new candidate. A candidate seen in min_observations
+// frames becomes a landmark with a fresh id (landmark ids are never reused); a candidate not seen
+// for candidate_timeout_frames frames expires, so spurious one-off detections never reach the map.
+// Landmark estimates are refined elsewhere (mapping/window.h); here they are created and counted.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <map>
+#include <vector>
+
+#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/mapping/association.h"
+#include "quadric_slam/mapping/landmark.h"
+
+namespace quadric_slam {
+
+// One frame's measurement of a candidate, kept so that a promoted landmark can receive the factors
+// of the frames that made it.
+struct CandidateObservation {
+  int frame_index = 0;
+  QuadricMeasurement measurement;
+};
+
+struct QuadricCandidate {
+  int id = 0;                  // candidate id (own counter; never a landmark id)
+  QuadricModel quadric_map;    // the latest measurement moved into the map at its predicted pose
+  Eigen::MatrixXd covariance;  // that measurement's covariance (body tangents are invariant)
+  ExtentBox extent;            // union of the observed boxes, in quadric_map's frame
+  int observations = 0;        // frames that saw it
+  int last_frame = 0;          // frame index of the latest
+  double last_observed = 0.0;  // stamp of the latest (s)
+  std::vector<CandidateObservation> history;  // the latest min_observations observations
+};
+
+// What happened to each measurement of a frame.
+enum class MeasurementFate {
+  kLandmark,      // associated with landmark `id`
+  kCandidate,     // associated with candidate `id`
+  kNewCandidate,  // started candidate `id`
+  kPromoted,      // its candidate reached min_observations: now landmark `id`
+};
+
+struct MeasurementResult {
+  MeasurementFate fate = MeasurementFate::kNewCandidate;
+  int id = 0;
+  Association landmark_association;  // the association against the landmarks
+};
+
+struct MapUpdate {
+  std::vector<MeasurementResult> measurements;  // one per input measurement, same order
+  // Landmarks created this frame, with the observations of the candidate they came from (this
+  // frame's included).
+  std::vector<int> promoted;
+  std::vector<std::vector<CandidateObservation>> promoted_history;
+  int expired_candidates = 0;
+};
+
+class QuadricMap {
+ public:
+  struct Params {
+    // Frames a candidate must be seen in before it becomes a landmark (the paper's 5), [1, 1000].
+    int min_observations = 5;
+    // A candidate not seen for more than this many frames is dropped, [1, 100000].
+    int candidate_timeout_frames = 15;
+    QuadricAssociator::Params association;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  QuadricMap() : QuadricMap(Params{}) {}
+  explicit QuadricMap(const Params& params);
+
+  // Associates a frame's (valid) measurements at the predicted pose T_map_camera with prediction
+  // covariance pose_covariance (6x6, body tangent), updates counts, stamps and extents, starts,
+  // promotes and expires candidates. frame_index must increase from call to call.
+  MapUpdate integrate(int frame_index, double stamp,
+                      const std::vector<QuadricMeasurement>& measurements,
+                      const Eigen::Isometry3d& T_map_camera, const Matrix6d& pose_covariance);
+
+  const std::map<int, QuadricLandmark>& landmarks() const { return landmarks_; }
+  // Throws std::out_of_range for an unknown id.
+  const QuadricLandmark& landmark(int id) const { return landmarks_.at(id); }
+  // The refiner's write access to an estimate (quadric and covariance); the extent is re-expressed
+  // in the new quadric frame. Throws std::out_of_range for an unknown id.
+  void setEstimate(int id, const QuadricModel& quadric_map, const Eigen::MatrixXd& covariance);
+  const std::vector<QuadricCandidate>& candidates() const { return candidates_; }
+
+  // Forgets landmarks and candidates; ids keep counting (never reused).
+  void clear();
+
+  const Params& params() const { return params_; }
+  const QuadricAssociator& associator() const { return associator_; }
+
+ private:
+  Params params_;
+  QuadricAssociator associator_;
+  std::map<int, QuadricLandmark> landmarks_;
+  std::vector<QuadricCandidate> candidates_;
+  int next_landmark_id_ = 1;
+  int next_candidate_id_ = 1;
+};
+
+}  // namespace quadric_slam

@@ -1,0 +1,116 @@
+// The mapping back-end, ROS-free: per frame, odometry + the front-end's quadric measurements in,
+// T_map_camera (hence T_map_odom) and the landmarks out.
+//   1. Predict T_map_camera = T_map_kf (T_odom_kf^-1 T_odom_camera) from the latest keyframe's
+//      optimised pose and the odometry since (the paper's "estimated previous pose concatenated
+//      with the latest odometry measurement"), with the odometry covariance accumulated since.
+//   2. Associate and count (mapping/quadric_map.h, mapping/association.h).
+//   3. Keyframe rule: the frame becomes a keyframe when it is the first, when the camera moved more
+//      than keyframe_translation or turned more than keyframe_rotation since the last keyframe
+//      (odometry), or when it observes a landmark that has no factor in the window (a new landmark,
+//      or an old one seen again: a loop). Only keyframes carry factors; other frames' observations
+//      count towards promotion and observation counts only.
+//   4. On a keyframe, optimise the sliding window (mapping/window.h): bounded cost per frame.
+// The map frame is the first frame's odom pose (T_map_odom = identity until corrections).
+//
+// Bad input has a defined behaviour and never reaches the map:
+//   - a stamp not finite or not after the previous accepted frame's: the frame is refused
+//     (kRejectedStamp), nothing changes; a looping bag must call reset();
+//   - a non-finite or non-rigid T_odom_camera, or an increment covariance that is not 6x6,
+//     symmetric, positive definite: the frame is refused (kRejectedOdometry);
+//   - a measurement with non-finite quadric parameters, or a covariance that is not k x k,
+//     finite, symmetric and positive definite: that measurement is dropped and counted
+//     (rejected_measurements), the rest of the frame is used.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/geometry/se3.h"
+#include "quadric_slam/mapping/quadric_map.h"
+#include "quadric_slam/mapping/window.h"
+
+namespace quadric_slam {
+
+// The odometry of one frame.
+struct OdometryInput {
+  Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();
+  // Covariance of the increment T_previous_this from the previous frame, in this frame's body
+  // tangent [rho; phi] (m, rad), 6x6; empty: the Params noise model is used. (OdometryTracker's
+  // covariance is cumulative since its start; pass the difference, or leave this empty.)
+  Eigen::MatrixXd increment_covariance;
+};
+
+enum class FrameStatus { kOk, kRejectedStamp, kRejectedOdometry };
+
+struct MapperFrameResult {
+  FrameStatus status = FrameStatus::kOk;
+  std::string message;  // why a frame or measurements were refused (empty when all was fine)
+  double stamp = 0.0;
+  Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_map_odom = Eigen::Isometry3d::Identity();
+  bool keyframe = false;
+  int rejected_measurements = 0;
+  // Per accepted measurement, in input order with the rejected ones left out.
+  MapUpdate update;
+  // Window statistics of this frame's optimisation (zeros for non-keyframes).
+  WindowStatistics window;
+  double association_seconds = 0.0;   // wall time of association and bookkeeping
+  double optimisation_seconds = 0.0;  // wall time of the window optimisation (keyframes)
+};
+
+class QuadricMapper {
+ public:
+  struct Params {
+    QuadricMap::Params map;
+    SlidingWindow::Params window;
+    // Keyframe rule (see above): m (> 0), rad (> 0).
+    double keyframe_translation = 0.15;
+    double keyframe_rotation = 0.17;
+    // Odometry noise model for frames without an increment covariance (1-sigma per increment):
+    // sigma_t = translation_sigma + translation_fraction |dt|,
+    // sigma_r = rotation_sigma + rotation_fraction |dtheta| + rotation_per_metre |dt|.
+    // m, >= 0; >= 0; rad, >= 0; >= 0; rad/m, >= 0 (and sigma_t, sigma_r > 0 overall).
+    double odometry_translation_sigma = 0.002;
+    double odometry_translation_fraction = 0.05;
+    double odometry_rotation_sigma = 0.002;
+    double odometry_rotation_fraction = 0.05;
+    double odometry_rotation_per_metre = 0.02;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  QuadricMapper() : QuadricMapper(Params{}) {}
+  explicit QuadricMapper(const Params& params);
+
+  MapperFrameResult process(const FrameMeasurements& frame, const OdometryInput& odometry);
+
+  // Forgets everything but the id counters (landmark ids are never reused).
+  void reset();
+
+  const QuadricMap& map() const { return map_; }
+  const SlidingWindow& window() const { return window_; }
+  // The landmarks as a list (id order).
+  std::vector<QuadricLandmark> landmarks() const;
+  const Params& params() const { return params_; }
+
+  // Why a measurement is unusable, or empty when it is fine.
+  static std::string validateMeasurement(const QuadricMeasurement& measurement);
+
+ private:
+  Matrix6d incrementCovariance(const Eigen::Isometry3d& T_previous_this) const;
+
+  Params params_;
+  QuadricMap map_;
+  SlidingWindow window_;
+  int frame_index_ = 0;
+  bool has_frame_ = false;
+  double last_stamp_ = 0.0;
+  Eigen::Isometry3d T_odom_previous_ = Eigen::Isometry3d::Identity();
+  Matrix6d covariance_since_keyframe_ = Matrix6d::Zero();  // body tangent of the latest frame
+};
+
+}  // namespace quadric_slam

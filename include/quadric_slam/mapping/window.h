@@ -1,0 +1,136 @@
+// Bounded-cost estimation: a sliding window over the last `size` keyframes. Each optimisation
+// builds one Ceres problem from
+//   - the window's keyframe poses T_map_camera (PoseManifold), odometry factors between
+//     consecutive window keyframes (RelativePoseCost),
+//   - the landmarks observed from window keyframes (QuadricManifold of their class) with one
+//     QuadricObservationCost per observation (eqs. 20-22),
+//   - the gauge: while the map's first keyframe is in the window it is held fixed (it defines the
+//     map frame); afterwards the oldest window pose gets a PosePriorCost at its current estimate,
+//   - for each landmark that was observed from keyframes that have left the window, a prior
+//     summarising those observations: when a keyframe leaves, each of its observations is
+//     linearised at the current estimates and its information J_q^T S^-1 J_q (S = Sigma_z +
+//     J_c P J_c^T, P the oldest-pose prior covariance: the leaving pose is taken as known to that
+//     accuracy) is added to the landmark's prior information; the prior's mean is the landmark's
+//     estimate at that moment. This keeps the history of a landmark that stays in view and gives
+//     a re-observed landmark (a loop) its earlier accuracy, at a cost of one k-dimensional factor
+//     per landmark. The prior is QuadricObservationCost of the prior quadric (map frame) from a
+//     constant identity pose, covariance landmark_prior_inflation * information^-1.
+// and solves it with a bounded number of iterations, so the cost per keyframe depends on the
+// window size and the landmarks in view, never on the sequence length. A keyframe leaving the
+// window takes its factors with it; a landmark no longer observed by any window keyframe leaves the
+// problem and keeps its last estimate and covariance in the map. (No Schur-complement
+// marginalisation: the information of a leaving keyframe is dropped, apart from the landmark priors
+// above.) Marginal covariances of the window's landmarks (ceres::Covariance, minimal tangent space)
+// are computed after each optimisation when compute_covariance is set; a landmark whose covariance
+// cannot be computed (rank-deficient window) keeps an empty one.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <deque>
+#include <map>
+#include <vector>
+
+#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/geometry/se3.h"
+#include "quadric_slam/mapping/quadric_map.h"
+
+namespace quadric_slam {
+
+struct WindowObservation {
+  int landmark_id = 0;
+  QuadricMeasurement measurement;  // validated: finite, k x k positive definite covariance
+};
+
+struct Keyframe {
+  int frame_index = 0;                                              // the mapper's frame counter
+  double stamp = 0.0;                                               // s
+  Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();   // estimate
+  Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();  // odometry
+  // Odometry from the previous keyframe to this one, T_prev_this, and its covariance in this
+  // keyframe's body tangent [rho; phi] (unused for the map's first keyframe).
+  Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();
+  Matrix6d increment_covariance = Matrix6d::Identity();
+  std::vector<WindowObservation> observations;
+};
+
+// Size of the last optimisation problem and how it went.
+struct WindowStatistics {
+  int keyframes = 0;
+  int pose_blocks = 0;       // variable and fixed window poses
+  int landmark_blocks = 0;   // landmarks in the window
+  int parameter_blocks = 0;  // as Ceres counts them (the constant identity pose of priors included)
+  int residual_blocks = 0;
+  int residuals = 0;
+  int observation_factors = 0, odometry_factors = 0, pose_priors = 0, landmark_priors = 0;
+  int iterations = 0;
+  double initial_cost = 0.0, final_cost = 0.0;
+  bool solution_usable = false;
+};
+
+class SlidingWindow {
+ public:
+  struct Params {
+    int size = 10;            // keyframes in the window, [2, 1000]
+    int max_iterations = 10;  // Levenberg-Marquardt iterations per optimisation, [1, 1000]
+    // Huber loss on the whitened observation residual (in sigmas), 0 = plain least squares; >= 0.
+    double observation_huber = 3.0;
+    // Prior holding the oldest window pose once the first keyframe has left (1-sigma, body
+    // frame): m and rad, > 0.
+    double oldest_pose_translation_sigma = 0.005;
+    double oldest_pose_rotation_sigma = 0.002;
+    // Landmark priors: factor (>= 1) on the folded covariance (the folding treats leaving poses
+    // as known to the oldest-pose prior's accuracy; inflate to be more conservative).
+    double landmark_prior_inflation = 1.0;
+    // Compute the landmarks' marginal covariances after each optimisation.
+    bool compute_covariance = true;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  SlidingWindow() : SlidingWindow(Params{}) {}
+  explicit SlidingWindow(const Params& params);
+
+  // Appends a keyframe (its T_map_camera initialised by the caller; its observations must name
+  // landmarks of `map`). When the window is over its size the oldest keyframe leaves; landmarks
+  // that lose their last window observation leave the problem.
+  void addKeyframe(Keyframe keyframe, const QuadricMap& map);
+  // Adds an observation of a landmark to the window keyframe of frame `frame_index` (the earlier
+  // frames of a just-promoted candidate). Returns false when that frame is not a window keyframe.
+  bool addObservation(int frame_index, const WindowObservation& observation);
+
+  // Optimises the window and writes the estimates back (keyframe poses here, landmarks into the
+  // map). When the solver fails or a landmark's estimate becomes invalid, the old estimates stay.
+  WindowStatistics optimize(QuadricMap* map);
+
+  const std::deque<Keyframe>& keyframes() const { return keyframes_; }
+  bool containsLandmark(int landmark_id) const {
+    return observation_counts_.count(landmark_id) > 0;
+  }
+  const WindowStatistics& lastStatistics() const { return last_; }
+  void clear();
+
+  const Params& params() const { return params_; }
+
+ private:
+  void countObservation(int landmark_id);
+  void foldIntoPrior(const Keyframe& keyframe, const WindowObservation& observation,
+                     const QuadricMap& map);
+
+  Params params_;
+  std::deque<Keyframe> keyframes_;
+  bool first_keyframe_in_window_ = false;
+  bool any_keyframe_ = false;
+  std::map<int, int> observation_counts_;  // landmark id -> observations in the window
+  struct LandmarkPrior {
+    QuadricModel quadric_map;     // mean: the estimate when the latest observation was folded in
+    Eigen::MatrixXd information;  // k x k, minimal tangent
+  };
+  // Landmarks whose observations from keyframes that left the window were folded in (one entry
+  // per landmark: grows with the map, not with the sequence).
+  std::map<int, LandmarkPrior> priors_;
+  WindowStatistics last_;
+};
+
+}  // namespace quadric_slam

@@ -1,0 +1,208 @@
+#include "quadric_slam/mapping/association.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "quadric_slam/geometry/quadric_classes.h"
+#include "quadric_slam/mapping/observation_linearization.h"
+
+namespace quadric_slam {
+
+namespace {
+
+void requireRange(bool ok, const char* field, const char* range) {
+  if (!ok)
+    throw std::invalid_argument(std::string("QuadricAssociator::Params::") + field +
+                                " must be in " + range);
+}
+
+// Diagonal model-error floor in the class's minimal space: each minimal column of B (Table II) is
+// a translation, rotation or scale direction.
+Eigen::MatrixXd floorCovariance(const QuadricAssociator::Params& p, const QuadricModel& target) {
+  const QuadricClassDefinition& def = classDefinition(target.quadricClass());
+  const int k = def.minimal_dimension;
+  Eigen::MatrixXd floor = Eigen::MatrixXd::Zero(k, k);
+  for (int j = 0; j < k; ++j) {
+    int row = 0;
+    def.basis.col(j).cwiseAbs().maxCoeff(&row);
+    double sigma = 0.0;
+    if (row < 3) {
+      sigma = p.floor_translation_sigma;
+    } else if (row < 6) {
+      sigma = p.floor_rotation_sigma;
+    } else {
+      const Eigen::Vector3d column = def.basis.col(j).tail<3>();
+      sigma = p.floor_scale_fraction * column.cwiseProduct(target.scale()).cwiseAbs().sum() /
+              column.cwiseAbs().sum();
+    }
+    floor(j, j) = sigma * sigma;
+  }
+  return floor;
+}
+
+// Regularised lower incomplete gamma P(a, x) by its power series (converges for every x > 0; the
+// gates need x < ~200).
+double gammaP(double a, double x) {
+  if (x <= 0.0)
+    return 0.0;
+  double term = 1.0 / a, sum = term;
+  for (int n = 1; n < 100000 && term > sum * 1e-16; ++n) {
+    term *= x / (a + n);
+    sum += term;
+  }
+  return std::min(1.0, std::exp(-x + a * std::log(x) - std::lgamma(a)) * sum);
+}
+
+}  // namespace
+
+// Bisection on the chi-square CDF P(k/2, x/2). (boost::math's inverse returns NaN for most k under
+// the -frounding-math that CGAL requires, so the project computes its own.)
+double chiSquareQuantile(int degrees_of_freedom, double probability) {
+  if (degrees_of_freedom < 1 || !(probability > 0.0 && probability < 1.0))
+    throw std::invalid_argument("chiSquareQuantile: needs k >= 1 and probability in (0, 1)");
+  double lo = 0.0, hi = 1.0;
+  while (gammaP(0.5 * degrees_of_freedom, 0.5 * hi) < probability)
+    hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (gammaP(0.5 * degrees_of_freedom, 0.5 * mid) < probability ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+bool sameKind(const QuadricModel& a, const QuadricModel& b) {
+  if (a.quadricClass() != b.quadricClass())
+    return false;
+  return a.quadricClass() != QuadricClass::kGeneral || a.signature() == b.signature();
+}
+
+void QuadricAssociator::Params::validate() const {
+  requireRange(gate_probability > 0.0 && gate_probability < 1.0, "gate_probability", "(0, 1)");
+  requireRange(floor_translation_sigma >= 0.0, "floor_translation_sigma", "[0, inf) m");
+  requireRange(floor_rotation_sigma >= 0.0, "floor_rotation_sigma", "[0, inf) rad");
+  requireRange(floor_scale_fraction >= 0.0, "floor_scale_fraction", "[0, inf)");
+  requireRange(pose_translation_sigma >= 0.0, "pose_translation_sigma", "[0, inf) m");
+  requireRange(pose_rotation_sigma >= 0.0, "pose_rotation_sigma", "[0, inf) rad");
+  requireRange(extent_margin >= 0.0, "extent_margin", "[0, inf) m");
+  requireRange(max_range > 0.0, "max_range", "(0, inf) m");
+}
+
+QuadricAssociator::QuadricAssociator(const Params& params) : params_(params) {
+  params_.validate();
+  for (QuadricClass c : kAllQuadricClasses) {
+    gates_[static_cast<int>(c)] = chiSquareQuantile(minimalDimension(c), params_.gate_probability);
+  }
+}
+
+double QuadricAssociator::gate(QuadricClass quadric_class) const {
+  return gates_.at(static_cast<int>(quadric_class));
+}
+
+double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
+                                       const Eigen::Isometry3d& T_map_camera,
+                                       const Matrix6d& pose_covariance,
+                                       const AssociationTarget& target) const {
+  const QuadricModel& z = measurement.quadric_camera;
+  if (!sameKind(z, target.quadric_map))
+    throw std::invalid_argument("QuadricAssociator: measurement and target of different classes");
+  const QuadricClass c = z.quadricClass();
+  const int k = minimalDimension(c);
+  if (measurement.covariance.rows() != k || measurement.covariance.cols() != k)
+    throw std::invalid_argument("QuadricAssociator: measurement covariance is not k x k");
+  if (target.covariance.size() != 0 &&
+      (target.covariance.rows() != k || target.covariance.cols() != k))
+    throw std::invalid_argument("QuadricAssociator: target covariance is not k x k");
+
+  const ObservationLinearization lin = linearizeObservation(z, T_map_camera, target.quadric_map);
+  if (!lin.valid)
+    return std::numeric_limits<double>::infinity();
+  const Eigen::VectorXd& r0 = lin.residual;
+  const Eigen::MatrixXd& J_c = lin.J_camera;
+  const Eigen::MatrixXd& J_q = lin.J_quadric;
+
+  Matrix6d P = pose_covariance;
+  const double st = params_.pose_translation_sigma, sr = params_.pose_rotation_sigma;
+  P.diagonal() += (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr).finished();
+  Eigen::MatrixXd S = measurement.covariance + floorCovariance(params_, target.quadric_map) +
+                      J_c * P * J_c.transpose();
+  if (target.covariance.size() != 0)
+    S += J_q * target.covariance * J_q.transpose();
+  S = 0.5 * (S + S.transpose()).eval();
+  const Eigen::LLT<Eigen::MatrixXd> llt(S);
+  if (llt.info() != Eigen::Success)
+    throw std::invalid_argument("QuadricAssociator: innovation covariance not positive definite");
+  return r0.dot(llt.solve(r0));
+}
+
+bool QuadricAssociator::inRange(const QuadricModel& quadric_map, const ExtentBox& extent,
+                                const Eigen::Isometry3d& T_map_camera) const {
+  if (!extent.known())
+    return true;
+  const Eigen::Vector3d c = quadric_map.pose().inverse() * T_map_camera.translation();
+  const Eigen::Vector3d outside = (extent.min - c).cwiseMax(c - extent.max).cwiseMax(0.0);
+  return outside.norm() <= params_.max_range;
+}
+
+std::vector<Association> QuadricAssociator::associate(
+    const std::vector<QuadricMeasurement>& measurements, const Eigen::Isometry3d& T_map_camera,
+    const Matrix6d& pose_covariance, const std::vector<AssociationTarget>& targets) const {
+  struct Pair {
+    double d2;
+    int measurement, target;
+  };
+  std::vector<Association> out(measurements.size());
+  std::vector<Pair> acceptable;
+  // Targets near enough to be compared: distance from the camera centre to the extent box.
+  std::vector<bool> near(targets.size(), true);
+  for (size_t t = 0; t < targets.size(); ++t)
+    near[t] = inRange(targets[t].quadric_map, targets[t].extent, T_map_camera);
+  for (size_t m = 0; m < measurements.size(); ++m) {
+    const QuadricMeasurement& measurement = measurements[m];
+    const ExtentBox observed{measurement.extent_min, measurement.extent_max};
+    const Eigen::Isometry3d T_map_observed = T_map_camera * measurement.quadric_camera.pose();
+    bool any_in_gate = false;
+    for (size_t t = 0; t < targets.size(); ++t) {
+      if (!near[t] || !sameKind(measurement.quadric_camera, targets[t].quadric_map))
+        continue;
+      const double d2 = squaredError(measurement, T_map_camera, pose_covariance, targets[t]);
+      if (d2 < out[m].squared_error)
+        out[m].squared_error = d2;
+      if (out[m].outcome == AssociationOutcome::kNoTargetOfClass)
+        out[m].outcome = AssociationOutcome::kOutsideGate;
+      if (!(d2 <= gate(measurement.quadric_camera.quadricClass())))
+        continue;
+      any_in_gate = true;
+      if (params_.check_extent) {
+        const ExtentBox moved =
+            observed.transformed(targets[t].quadric_map.pose().inverse() * T_map_observed);
+        if (!moved.overlaps(targets[t].extent, params_.extent_margin))
+          continue;
+      }
+      acceptable.push_back({d2, static_cast<int>(m), static_cast<int>(t)});
+    }
+    if (any_in_gate)
+      out[m].outcome = AssociationOutcome::kNoOverlap;
+  }
+  for (const Pair& pair : acceptable)
+    out[pair.measurement].outcome = AssociationOutcome::kTakenByBetter;
+  std::sort(acceptable.begin(), acceptable.end(), [](const Pair& a, const Pair& b) {
+    return a.d2 < b.d2 || (a.d2 == b.d2 && a.target < b.target);
+  });
+  std::vector<bool> target_taken(targets.size(), false);
+  std::vector<bool> measurement_done(measurements.size(), false);
+  for (const Pair& pair : acceptable) {
+    if (measurement_done[pair.measurement] || target_taken[pair.target])
+      continue;
+    measurement_done[pair.measurement] = target_taken[pair.target] = true;
+    Association& a = out[pair.measurement];
+    a.outcome = AssociationOutcome::kMatched;
+    a.target_index = pair.target;
+    a.squared_error = pair.d2;
+  }
+  return out;
+}
+
+}  // namespace quadric_slam

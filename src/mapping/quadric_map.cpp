@@ -1,0 +1,190 @@
+#include "quadric_slam/mapping/quadric_map.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "quadric_slam/geometry/symmetry.h"
+
+namespace quadric_slam {
+
+namespace {
+
+void requireRange(bool ok, const char* field, const char* range) {
+  if (!ok)
+    throw std::invalid_argument(std::string("QuadricMap::Params::") + field + " must be in " +
+                                range);
+}
+
+ExtentBox landmarkExtent(const QuadricLandmark& landmark) {
+  return ExtentBox{landmark.extent_min, landmark.extent_max};
+}
+
+void setLandmarkExtent(QuadricLandmark* landmark, const ExtentBox& box) {
+  landmark->extent_min = box.min;
+  landmark->extent_max = box.max;
+}
+
+// The measurement's box moved into the frame of `quadric_map` through the predicted pose.
+ExtentBox observedExtentIn(const QuadricMeasurement& measurement,
+                           const Eigen::Isometry3d& T_map_camera, const QuadricModel& quadric_map) {
+  const ExtentBox observed{measurement.extent_min, measurement.extent_max};
+  return observed.transformed(quadric_map.pose().inverse() * T_map_camera *
+                              measurement.quadric_camera.pose());
+}
+
+}  // namespace
+
+void QuadricMap::Params::validate() const {
+  requireRange(min_observations >= 1 && min_observations <= 1000, "min_observations", "[1, 1000]");
+  requireRange(candidate_timeout_frames >= 1 && candidate_timeout_frames <= 100000,
+               "candidate_timeout_frames", "[1, 100000]");
+  association.validate();
+}
+
+QuadricMap::QuadricMap(const Params& params) : params_(params), associator_(params.association) {
+  params_.validate();
+}
+
+MapUpdate QuadricMap::integrate(int frame_index, double stamp,
+                                const std::vector<QuadricMeasurement>& measurements,
+                                const Eigen::Isometry3d& T_map_camera,
+                                const Matrix6d& pose_covariance) {
+  MapUpdate update;
+  update.measurements.resize(measurements.size());
+
+  // 1. Against the landmarks.
+  std::vector<AssociationTarget> targets;
+  std::vector<int> target_ids;
+  for (const auto& [id, landmark] : landmarks_) {
+    // Landmarks far from the camera are not even copied (bounded per-frame work).
+    const ExtentBox extent = landmarkExtent(landmark);
+    if (!associator_.inRange(landmark.quadric_map, extent, T_map_camera))
+      continue;
+    targets.push_back({id, landmark.quadric_map, landmark.covariance, extent});
+    target_ids.push_back(id);
+  }
+  const std::vector<Association> to_landmarks =
+      associator_.associate(measurements, T_map_camera, pose_covariance, targets);
+  std::vector<QuadricMeasurement> rest;
+  std::vector<int> rest_index;
+  for (size_t m = 0; m < measurements.size(); ++m) {
+    update.measurements[m].landmark_association = to_landmarks[m];
+    if (to_landmarks[m].outcome != AssociationOutcome::kMatched) {
+      rest.push_back(measurements[m]);
+      rest_index.push_back(static_cast<int>(m));
+      continue;
+    }
+    QuadricLandmark& landmark = landmarks_.at(target_ids[to_landmarks[m].target_index]);
+    landmark.observations += 1;
+    landmark.last_observed = stamp;
+    setLandmarkExtent(&landmark, landmarkExtent(landmark).merged(observedExtentIn(
+                                     measurements[m], T_map_camera, landmark.quadric_map)));
+    update.measurements[m].fate = MeasurementFate::kLandmark;
+    update.measurements[m].id = landmark.id;
+  }
+
+  // 2. The rest against the candidates; 3. what matches nothing starts a candidate.
+  targets.clear();
+  std::vector<int> candidate_index;
+  for (size_t c = 0; c < candidates_.size(); ++c) {
+    const QuadricCandidate& candidate = candidates_[c];
+    if (!associator_.inRange(candidate.quadric_map, candidate.extent, T_map_camera))
+      continue;
+    targets.push_back(
+        {candidate.id, candidate.quadric_map, candidate.covariance, candidate.extent});
+    candidate_index.push_back(static_cast<int>(c));
+  }
+  const std::vector<Association> to_candidates =
+      associator_.associate(rest, T_map_camera, pose_covariance, targets);
+  for (size_t r = 0; r < rest.size(); ++r) {
+    const QuadricMeasurement& measurement = rest[r];
+    const QuadricModel moved = measurement.quadric_camera.transformed(T_map_camera);
+    const ExtentBox observed = observedExtentIn(measurement, T_map_camera, moved);
+    MeasurementResult& result = update.measurements[rest_index[r]];
+    if (to_candidates[r].outcome == AssociationOutcome::kMatched) {
+      QuadricCandidate& candidate = candidates_[candidate_index[to_candidates[r].target_index]];
+      // The estimate follows the latest measurement, re-expressed by the member of its symmetry
+      // orbit closest to the previous estimate (so the box frame barely turns); the covariance is
+      // re-expressed with it (geometry/symmetry.h).
+      const QuadricModel aligned = alignToReference(moved, candidate.quadric_map);
+      const Eigen::MatrixXd M =
+          minimalAdjoint(moved.quadricClass(), aligned.pose().inverse() * moved.pose());
+      candidate.extent =
+          candidate.extent.transformed(aligned.pose().inverse() * candidate.quadric_map.pose())
+              .merged(observedExtentIn(measurement, T_map_camera, aligned));
+      candidate.quadric_map = aligned;
+      candidate.covariance = M * measurement.covariance * M.transpose();
+      candidate.observations += 1;
+      candidate.last_frame = frame_index;
+      candidate.last_observed = stamp;
+      candidate.history.push_back({frame_index, measurement});
+      if (static_cast<int>(candidate.history.size()) > params_.min_observations)
+        candidate.history.erase(candidate.history.begin());
+      result.fate = MeasurementFate::kCandidate;
+      result.id = candidate.id;
+    } else {
+      QuadricCandidate candidate;
+      candidate.id = next_candidate_id_++;
+      candidate.quadric_map = moved;
+      candidate.covariance = measurement.covariance;
+      candidate.extent = observed;
+      candidate.observations = 1;
+      candidate.last_frame = frame_index;
+      candidate.last_observed = stamp;
+      candidate.history.push_back({frame_index, measurement});
+      candidates_.push_back(candidate);
+      result.fate = MeasurementFate::kNewCandidate;
+      result.id = candidate.id;
+    }
+  }
+
+  // 4. Promotion of candidates seen often enough (this frame's only: others were checked before).
+  std::vector<QuadricCandidate> kept;
+  for (QuadricCandidate& candidate : candidates_) {
+    if (candidate.last_frame == frame_index && candidate.observations >= params_.min_observations) {
+      QuadricLandmark landmark;
+      landmark.id = next_landmark_id_++;
+      landmark.quadric_map = candidate.quadric_map;
+      landmark.observations = candidate.observations;
+      landmark.last_observed = candidate.last_observed;
+      setLandmarkExtent(&landmark, candidate.extent);
+      for (MeasurementResult& result : update.measurements) {
+        if ((result.fate == MeasurementFate::kCandidate ||
+             result.fate == MeasurementFate::kNewCandidate) &&
+            result.id == candidate.id) {
+          result.fate = MeasurementFate::kPromoted;
+          result.id = landmark.id;
+        }
+      }
+      update.promoted.push_back(landmark.id);
+      update.promoted_history.push_back(candidate.history);
+      landmarks_.emplace(landmark.id, landmark);
+      continue;
+    }
+    // 5. Expiry.
+    if (frame_index - candidate.last_frame > params_.candidate_timeout_frames) {
+      ++update.expired_candidates;
+      continue;
+    }
+    kept.push_back(std::move(candidate));
+  }
+  candidates_ = std::move(kept);
+  return update;
+}
+
+void QuadricMap::setEstimate(int id, const QuadricModel& quadric_map,
+                             const Eigen::MatrixXd& covariance) {
+  QuadricLandmark& landmark = landmarks_.at(id);
+  setLandmarkExtent(&landmark, landmarkExtent(landmark).transformed(quadric_map.pose().inverse() *
+                                                                    landmark.quadric_map.pose()));
+  landmark.quadric_map = quadric_map;
+  landmark.covariance = covariance;
+}
+
+void QuadricMap::clear() {
+  landmarks_.clear();
+  candidates_.clear();
+}
+
+}  // namespace quadric_slam

@@ -1,0 +1,228 @@
+#include "quadric_slam/mapping/quadric_mapper.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "quadric_slam/mapping/factors.h"
+
+namespace quadric_slam {
+
+namespace {
+
+void requireRange(bool ok, const char* field, const char* range) {
+  if (!ok)
+    throw std::invalid_argument(std::string("QuadricMapper::Params::") + field + " must be in " +
+                                range);
+}
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+bool isRigid(const Eigen::Isometry3d& T) {
+  if (!T.matrix().allFinite())
+    return false;
+  const Eigen::Matrix3d R = T.linear();
+  return (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-6 &&
+         R.determinant() > 0.0;
+}
+
+double rotationAngle(const Eigen::Isometry3d& T) {
+  return Eigen::AngleAxisd(T.linear()).angle();
+}
+
+}  // namespace
+
+void QuadricMapper::Params::validate() const {
+  map.validate();
+  window.validate();
+  requireRange(keyframe_translation > 0.0, "keyframe_translation", "(0, inf) m");
+  requireRange(keyframe_rotation > 0.0, "keyframe_rotation", "(0, inf) rad");
+  requireRange(odometry_translation_sigma >= 0.0, "odometry_translation_sigma", "[0, inf) m");
+  requireRange(odometry_translation_fraction >= 0.0, "odometry_translation_fraction", "[0, inf)");
+  requireRange(odometry_rotation_sigma >= 0.0, "odometry_rotation_sigma", "[0, inf) rad");
+  requireRange(odometry_rotation_fraction >= 0.0, "odometry_rotation_fraction", "[0, inf)");
+  requireRange(odometry_rotation_per_metre >= 0.0, "odometry_rotation_per_metre", "[0, inf) rad/m");
+  requireRange(odometry_translation_sigma > 0.0 || odometry_translation_fraction > 0.0,
+               "odometry_translation_sigma", "(0, inf) m when odometry_translation_fraction is 0");
+  requireRange(odometry_rotation_sigma > 0.0 || odometry_rotation_fraction > 0.0 ||
+                   odometry_rotation_per_metre > 0.0,
+               "odometry_rotation_sigma", "(0, inf) rad when the other rotation terms are 0");
+}
+
+QuadricMapper::QuadricMapper(const Params& params)
+    : params_(params), map_(params.map), window_(params.window) {
+  params_.validate();
+}
+
+std::string QuadricMapper::validateMeasurement(const QuadricMeasurement& measurement) {
+  const QuadricModel& z = measurement.quadric_camera;
+  if (!z.pose().matrix().allFinite() || !z.scale().allFinite() || !z.signature().allFinite())
+    return "quadric parameters not finite";
+  if (!isRigid(z.pose()))
+    return "quadric pose not rigid";
+  const int k = minimalDimension(z.quadricClass());
+  if (measurement.covariance.rows() != k || measurement.covariance.cols() != k)
+    return "covariance is not " + std::to_string(k) + "x" + std::to_string(k) + " for a " +
+           toString(z.quadricClass());
+  try {
+    if (!sqrtInformation(measurement.covariance, "measurement").allFinite())
+      return "covariance not invertible";
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+Matrix6d QuadricMapper::incrementCovariance(const Eigen::Isometry3d& T_previous_this) const {
+  const double dt = T_previous_this.translation().norm();
+  const double dr = rotationAngle(T_previous_this);
+  const double st = params_.odometry_translation_sigma + params_.odometry_translation_fraction * dt;
+  const double sr = params_.odometry_rotation_sigma + params_.odometry_rotation_fraction * dr +
+                    params_.odometry_rotation_per_metre * dt;
+  // Keep the covariance positive definite for a zero increment with zero constant terms.
+  const double st2 = std::max(st * st, 1e-12), sr2 = std::max(sr * sr, 1e-12);
+  return (Vector6d() << st2, st2, st2, sr2, sr2, sr2).finished().asDiagonal();
+}
+
+MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
+                                         const OdometryInput& odometry) {
+  const auto start = std::chrono::steady_clock::now();
+  MapperFrameResult result;
+  result.stamp = frame.stamp;
+  // The current best pose of the latest frame, reported for refused frames.
+  auto latestEstimate = [&]() {
+    if (window_.keyframes().empty())
+      return T_odom_previous_;
+    const Keyframe& kf = window_.keyframes().back();
+    return Eigen::Isometry3d(kf.T_map_camera * kf.T_odom_camera.inverse() * T_odom_previous_);
+  };
+  auto refuse = [&](FrameStatus status, const std::string& why) {
+    result.status = status;
+    result.message = why;
+    result.T_map_camera = latestEstimate();
+    result.T_map_odom = result.T_map_camera * T_odom_previous_.inverse();
+    return result;
+  };
+
+  if (!std::isfinite(frame.stamp))
+    return refuse(FrameStatus::kRejectedStamp, "stamp is not finite");
+  if (has_frame_ && frame.stamp <= last_stamp_)
+    return refuse(FrameStatus::kRejectedStamp,
+                  "stamp " + std::to_string(frame.stamp) + " s is not after the previous " +
+                      std::to_string(last_stamp_) + " s (call reset() for a looping input)");
+  const Eigen::Isometry3d& T_odom_camera = odometry.T_odom_camera;
+  if (!isRigid(T_odom_camera))
+    return refuse(FrameStatus::kRejectedOdometry, "T_odom_camera is not a finite rigid transform");
+  const Eigen::Isometry3d T_previous_this =
+      has_frame_ ? Eigen::Isometry3d(T_odom_previous_.inverse() * T_odom_camera)
+                 : Eigen::Isometry3d::Identity();
+  Matrix6d increment_covariance;
+  if (odometry.increment_covariance.size() != 0) {
+    if (odometry.increment_covariance.rows() != 6 || odometry.increment_covariance.cols() != 6)
+      return refuse(FrameStatus::kRejectedOdometry, "increment covariance is not 6x6");
+    try {
+      sqrtInformation(odometry.increment_covariance, "increment covariance");
+    } catch (const std::invalid_argument& e) {
+      return refuse(FrameStatus::kRejectedOdometry, e.what());
+    }
+    increment_covariance = odometry.increment_covariance;
+  } else {
+    increment_covariance = incrementCovariance(T_previous_this);
+  }
+
+  // Accepted: from here on the state changes.
+  ++frame_index_;
+  has_frame_ = true;
+  last_stamp_ = frame.stamp;
+  T_odom_previous_ = T_odom_camera;
+  const Matrix6d Ad = adjointSE3(T_previous_this.inverse());
+  covariance_since_keyframe_ =
+      Ad * covariance_since_keyframe_ * Ad.transpose() + increment_covariance;
+
+  std::vector<QuadricMeasurement> valid;
+  for (const QuadricMeasurement& measurement : frame.observations) {
+    const std::string why = validateMeasurement(measurement);
+    if (why.empty()) {
+      valid.push_back(measurement);
+      continue;
+    }
+    ++result.rejected_measurements;
+    result.message +=
+        (result.message.empty() ? "" : "; ") + std::string("measurement dropped: ") + why;
+  }
+
+  // 1. Prediction from the latest keyframe and the odometry since.
+  const bool first = window_.keyframes().empty();
+  Eigen::Isometry3d T_map_predicted = T_odom_camera;
+  Eigen::Isometry3d T_keyframe_this = Eigen::Isometry3d::Identity();
+  if (!first) {
+    const Keyframe& kf = window_.keyframes().back();
+    T_keyframe_this = kf.T_odom_camera.inverse() * T_odom_camera;
+    T_map_predicted = kf.T_map_camera * T_keyframe_this;
+  }
+
+  // 2. Association and bookkeeping.
+  result.update =
+      map_.integrate(frame_index_, frame.stamp, valid, T_map_predicted, covariance_since_keyframe_);
+
+  // 3. Keyframe rule.
+  bool keyframe = first || T_keyframe_this.translation().norm() > params_.keyframe_translation ||
+                  rotationAngle(T_keyframe_this) > params_.keyframe_rotation;
+  Keyframe kf;
+  for (size_t m = 0; m < valid.size(); ++m) {
+    const MeasurementResult& r = result.update.measurements[m];
+    if (r.fate != MeasurementFate::kLandmark && r.fate != MeasurementFate::kPromoted)
+      continue;
+    kf.observations.push_back({r.id, valid[m]});
+    if (!window_.containsLandmark(r.id))
+      keyframe = true;
+  }
+  result.association_seconds = secondsSince(start);
+
+  // 4. Window optimisation on keyframes.
+  if (keyframe) {
+    const auto optimisation_start = std::chrono::steady_clock::now();
+    kf.frame_index = frame_index_;
+    kf.stamp = frame.stamp;
+    kf.T_map_camera = T_map_predicted;
+    kf.T_odom_camera = T_odom_camera;
+    kf.T_previous_this = T_keyframe_this;
+    kf.increment_covariance = first ? Matrix6d::Identity() : covariance_since_keyframe_;
+    window_.addKeyframe(std::move(kf), map_);
+    for (size_t p = 0; p < result.update.promoted.size(); ++p) {
+      for (const CandidateObservation& o : result.update.promoted_history[p]) {
+        if (o.frame_index != frame_index_)
+          window_.addObservation(o.frame_index, {result.update.promoted[p], o.measurement});
+      }
+    }
+    result.window = window_.optimize(&map_);
+    result.T_map_camera = window_.keyframes().back().T_map_camera;
+    covariance_since_keyframe_.setZero();
+    result.keyframe = true;
+    result.optimisation_seconds = secondsSince(optimisation_start);
+  } else {
+    result.T_map_camera = T_map_predicted;
+  }
+  result.T_map_odom = result.T_map_camera * T_odom_camera.inverse();
+  return result;
+}
+
+void QuadricMapper::reset() {
+  map_.clear();
+  window_.clear();
+  has_frame_ = false;
+  last_stamp_ = 0.0;
+  T_odom_previous_ = Eigen::Isometry3d::Identity();
+  covariance_since_keyframe_.setZero();
+}
+
+std::vector<QuadricLandmark> QuadricMapper::landmarks() const {
+  std::vector<QuadricLandmark> out;
+  for (const auto& [id, landmark] : map_.landmarks())
+    out.push_back(landmark);
+  return out;
+}
+
+}  // namespace quadric_slam
