@@ -19,6 +19,10 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
   std::vector<Eigen::Isometry3d> T_quadric_camera(n);
   for (int k = 0; k < n; ++k)
     T_quadric_camera[k] = segmentation.detections[k].shape.quadric().pose().inverse();
+  // Each detection's own noise level: rim points must fit as well as its supporting points.
+  std::vector<double> gate(n);
+  for (int k = 0; k < n; ++k)
+    gate[k] = std::max(1e-3, settings.rms_multiple * segmentation.detections[k].fit_rms);
   // Labels of detections only (defensive: a label without a detection is never spread).
   const auto owner = [&](std::uint16_t label) { return label >= 1 && label <= n ? label : 0; };
 
@@ -62,14 +66,16 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
     for (const int index : front) {
       const pcl::PointNormal& q = cloud.points[index];
       const Eigen::Vector3d point(q.x, q.y, q.z);
-      double best_distance = depthThreshold(q.z, settings.distance_factor, settings.min_distance);
+      const double threshold = depthThreshold(q.z, settings.distance_factor, settings.min_distance);
+      double best_distance = threshold;
       std::uint16_t best = 0;
       forEachNeighbour(index, [&](int, int nu, int nv) {
         const std::uint16_t label = owner(labels.at<std::uint16_t>(nv, nu));
         if (label == 0 || label == best)
           return;
-        const double distance = std::abs(segmentation.detections[label - 1].shape.distance(point));
-        if (distance < best_distance) {
+        const QuadricDetection& detection = segmentation.detections[label - 1];
+        const double distance = std::abs(detection.shape.distance(point));
+        if (distance < best_distance && distance < gate[label - 1]) {
           best_distance = distance;
           best = label;
         }

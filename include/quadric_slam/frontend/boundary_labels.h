@@ -2,10 +2,11 @@
 // to points within a few pixels of a depth edge or a hole (their smoothing window would straddle
 // it), so the segmenter, which needs normals, leaves an unlabelled rim around every segment; on a
 // small object seen in front of a background that rim is a large part of it. Here a point with
-// depth but without a normal, next to a labelled pixel, joins that detection when it lies within
-// the distance threshold of its surface (the closest such surface when several border it), ring
-// by ring up to a few pixels out. Points that have a normal were judged by the segmenter and are
-// left as they are.
+// depth but without a normal, next to a labelled pixel, joins that detection when it fits the
+// surface as well as the segment's own points do: within rms_multiple x the fit's RMS (and the
+// segmenter's distance threshold), so the mixed-depth "flying pixels" of a depth edge stay out. The
+// closest surface wins when several border the point; growth is ring by ring, a few pixels out.
+// Points that have a normal were judged by the segmenter and are left as they are.
 #pragma once
 
 #include <pcl/point_cloud.h>
@@ -21,6 +22,7 @@ struct BoundaryCompletion {
   double max_range = 4.5;
   double distance_factor = 0.008;  // threshold max(min_distance, distance_factor * z^2) (1/m, m)
   double min_distance = 0.006;
+  double rms_multiple = 3.0;  // distance gate in RMS of the detection's fit (>= 1 mm)
 };
 
 // Adds the boundary points to segmentation.labels and to each detection's num_points, roi and

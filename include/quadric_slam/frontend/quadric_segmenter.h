@@ -40,8 +40,10 @@ struct QuadricDetection {
   // cone (rho1..3, phi1, phi2, s)), a right (body-frame) perturbation of shape.quadric() with s
   // the radial entry of S: sigma^2 (J^T J)^-1 of the least squares.
   Eigen::MatrixXd covariance;
-  int num_points = 0;    // supporting points (cloud grid)
-  double fit_rms = 0.0;  // RMS geometric distance of the supporting points (m)
+  // Supporting points (cloud grid): the labelled pixels, boundary points without normals included
+  // (boundary_labels.h); the fit, its RMS and covariance use the points with normals.
+  int num_points = 0;
+  double fit_rms = 0.0;  // RMS geometric distance of the fit's points (m)
   std::uint16_t label = 0;
   ImageRoi roi;  // bounding box of the supporting pixels in the cloud's grid
   // Axis-aligned box of the supporting points in the frame of shape.quadric() (m).

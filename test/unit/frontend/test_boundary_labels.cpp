@@ -115,3 +115,24 @@ TEST(BoundaryLabels, PointsWithNormalsAndOutOfRangeStayUnlabelled) {
   qs::completeBoundaryLabels(cloud, qs::BoundaryCompletion(), empty);
   EXPECT_EQ(cv::countNonZero(empty.labels), 0);
 }
+
+TEST(BoundaryLabels, FlyingPixelsBeyondTheFitNoiseStayOut) {
+  auto cloud = wallScene();
+  // Column 13 lies 5 mm behind the wall: inside the segmenter's 8 mm threshold at 1 m, but beyond
+  // 3 x the fit's 1 mm RMS, like the mixed depths at a depth edge.
+  for (int v = 0; v < kHeight; ++v)
+    cloud(13, v).z += 0.005f;
+  qs::Segmentation segmentation = wallSegmentation(cloud);
+  segmentation.detections[0].fit_rms = 0.001;
+  qs::completeBoundaryLabels(cloud, qs::BoundaryCompletion(), segmentation);
+  for (int v = 0; v < kHeight; ++v) {
+    EXPECT_EQ(segmentation.labels.at<std::uint16_t>(v, 13), 0);
+    EXPECT_EQ(segmentation.labels.at<std::uint16_t>(v, 12), 0) << "not reached past column 13";
+    EXPECT_EQ(segmentation.labels.at<std::uint16_t>(v, 26), 1);
+  }
+  segmentation = wallSegmentation(cloud);
+  segmentation.detections[0].fit_rms = 0.002;  // noisier fit: 6 mm gate
+  qs::completeBoundaryLabels(cloud, qs::BoundaryCompletion(), segmentation);
+  for (int v = 0; v < kHeight; ++v)
+    EXPECT_EQ(segmentation.labels.at<std::uint16_t>(v, 13), 1);
+}
