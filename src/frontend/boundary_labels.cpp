@@ -26,19 +26,14 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
   // Labels of detections only (defensive: a label without a detection is never spread).
   const auto owner = [&](std::uint16_t label) { return label >= 1 && label <= n ? label : 0; };
 
-  // Pixels that may still join: depth in range, no normal, unlabelled.
-  std::vector<std::uint8_t> open(cloud.size(), 0);
-  for (int v = 0; v < height; ++v) {
-    const std::uint16_t* label_row = labels.ptr<std::uint16_t>(v);
-    for (int u = 0; u < width; ++u) {
-      const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
-      open[static_cast<std::size_t>(v) * width + u] =
-          label_row[u] == 0 && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
-          q.z >= settings.min_range && q.z <= settings.max_range && !std::isfinite(q.normal_x);
-    }
-  }
-  // The first front: open pixels next to a labelled one; later fronts: open pixels next to a pixel
-  // that joined in the previous ring (so the work follows the rim, not the image).
+  // A pixel may join when it is unlabelled, has depth in range and no normal. Only pixels next to
+  // the labels are examined (the label image is read first, the cloud only there), so the work
+  // follows the rim, not the image.
+  const auto mayJoin = [&](int index) {
+    const pcl::PointNormal& q = cloud.points[index];
+    return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+           q.z >= settings.min_range && q.z <= settings.max_range && !std::isfinite(q.normal_x);
+  };
   const auto forEachNeighbour = [&](int index, auto fn) {
     const int u = index % width, v = index / width;
     for (int dv = -1; dv <= 1; ++dv) {
@@ -49,16 +44,37 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
       }
     }
   };
+  std::vector<std::uint8_t> queued(cloud.size(), 0);
+  // The first front: candidates next to a labelled pixel, found with a 3x3 dilation of the label
+  // mask done as a horizontal then a vertical pass (a few operations per pixel).
+  std::vector<std::uint8_t> near_row(cloud.size(), 0);  // a label within one pixel in the row
+  for (int v = 0; v < height; ++v) {
+    const std::uint16_t* row = labels.ptr<std::uint16_t>(v);
+    std::uint8_t* out = &near_row[static_cast<std::size_t>(v) * width];
+    for (int u = 0; u < width; ++u) {
+      if (owner(row[u]) == 0)
+        continue;
+      out[u] = 1;
+      if (u > 0)
+        out[u - 1] = 1;
+      if (u + 1 < width)
+        out[u + 1] = 1;
+    }
+  }
   std::vector<int> front;
-  for (int index = 0; index < static_cast<int>(cloud.size()); ++index) {
-    if (!open[index])
-      continue;
-    bool next_to_label = false;
-    forEachNeighbour(index, [&](int, int nu, int nv) {
-      next_to_label = next_to_label || owner(labels.at<std::uint16_t>(nv, nu)) != 0;
-    });
-    if (next_to_label)
-      front.push_back(index);
+  for (int v = 0; v < height; ++v) {
+    const std::uint16_t* row = labels.ptr<std::uint16_t>(v);
+    const std::uint8_t* above = &near_row[static_cast<std::size_t>(std::max(0, v - 1)) * width];
+    const std::uint8_t* here = &near_row[static_cast<std::size_t>(v) * width];
+    const std::uint8_t* below =
+        &near_row[static_cast<std::size_t>(std::min(height - 1, v + 1)) * width];
+    for (int u = 0; u < width; ++u) {
+      const int index = v * width + u;
+      if (row[u] == 0 && (above[u] | here[u] | below[u]) != 0 && mayJoin(index)) {
+        queued[index] = 1;
+        front.push_back(index);
+      }
+    }
   }
   for (int ring = 0; ring < settings.rings && !front.empty(); ++ring) {
     // Each ring reads the labels of the previous one only, so growth is one pixel per ring.
@@ -69,10 +85,13 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
       const double threshold = depthThreshold(q.z, settings.distance_factor, settings.min_distance);
       double best_distance = threshold;
       std::uint16_t best = 0;
+      std::uint16_t tried[8];  // each bordering surface is measured once
+      int tried_count = 0;
       forEachNeighbour(index, [&](int, int nu, int nv) {
         const std::uint16_t label = owner(labels.at<std::uint16_t>(nv, nu));
-        if (label == 0 || label == best)
+        if (label == 0 || std::find(tried, tried + tried_count, label) != tried + tried_count)
           return;
+        tried[tried_count++] = label;
         const QuadricDetection& detection = segmentation.detections[label - 1];
         const double distance = std::abs(detection.shape.distance(point));
         if (distance < best_distance && distance < gate[label - 1]) {
@@ -82,12 +101,13 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
       });
       if (best != 0)
         joined.emplace_back(index, best);
+      else
+        queued[index] = 0;  // may be reached again from a neighbour that joins later
     }
     std::vector<int> next_front;
     for (const auto& [index, label] : joined) {
       const int u = index % width, v = index / width;
       labels.at<std::uint16_t>(v, u) = label;
-      open[index] = 0;
       QuadricDetection& detection = segmentation.detections[label - 1];
       ++detection.num_points;
       const pcl::PointNormal& q = cloud.points[index];
@@ -103,15 +123,13 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
       roi.height = y1 - roi.y_offset + 1;
     }
     for (const auto& [index, label] : joined) {
-      forEachNeighbour(index, [&](int neighbour, int, int) {
-        if (open[neighbour] == 1) {
-          open[neighbour] = 2;  // queued once
+      forEachNeighbour(index, [&](int neighbour, int nu, int nv) {
+        if (!queued[neighbour] && labels.at<std::uint16_t>(nv, nu) == 0 && mayJoin(neighbour)) {
+          queued[neighbour] = 1;
           next_front.push_back(neighbour);
         }
       });
     }
-    for (const int index : next_front)
-      open[index] = 1;
     front.swap(next_front);
   }
 }
