@@ -1,12 +1,16 @@
 // run_bag: the offline runner. Pushes every frame of a TUM rosbag or TUM folder through the same
-// core classes the nodelets use (back-projection + normals, quadric segmentation, odometry), with
-// the same config/*.yaml parameters, as fast as the machine
-// allows: no master, no real-time pacing. Writes DIR/trajectory.txt (TUM format, camera optical
-// frame in the odom frame) and DIR/timing.json (per-stage median/p95/max); with --gt prints the
-// ATE and RPE.
+// core classes the nodelets use (back-projection + normals, quadric segmentation, odometry,
+// mapping), with the same config/*.yaml parameters, as fast as the machine allows: no master, no
+// real-time pacing. Writes DIR/trajectory.txt (TUM format, camera optical frame in the odom frame),
+// DIR/timing.json (per-stage median/p95/max) and, unless --odometry-only, the mapper's
+// DIR/trajectory_map.txt (camera in the map frame), DIR/map.yaml (the landmarks, map schema) and
+// DIR/reconstruction.pcd (landmark points projected onto their surfaces, label = landmark id);
+// with --gt prints the ATE and RPE of the odometry (ate_rmse_m ...) and of the mapper
+// (map_ate_rmse_m ...).
 //
 //   run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR] [--max-frames N]
 //           [--intrinsics fx,fy,cx,cy] [--quiet]
+#include <pcl/io/pcd_io.h>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -20,14 +24,19 @@
 
 #include "quadric_slam/eval/stage_timing.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
+#include "quadric_slam/frontend/detection_measurement.h"
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/frontend/segmenter_params.h"
 #include "quadric_slam/io/frame_source.h"
+#include "quadric_slam/io/landmark_map_file.h"
+#include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/io/pipeline_params.h"
 #include "quadric_slam/io/trajectory_io.h"
 #include "quadric_slam/io/tum_folder_reader.h"
+#include "quadric_slam/mapping/quadric_mapper.h"
+#include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
 #include "quadric_slam/ros/tum_bag_reader.h"
 
@@ -119,18 +128,35 @@ qs::YamlParamReader configFile(const Options& o, const std::string& name) {
   return qs::YamlParamReader::fromFile(o.config_dir + "/" + name);
 }
 
-void printTrajectoryErrors(const std::string& gt_path, const qs::Trajectory& estimate) {
+// Prints <prefix>ate_rmse_m, <prefix>pairs and <prefix>rpe_m_per_s.
+void printTrajectoryErrors(const std::string& gt_path, const qs::Trajectory& estimate,
+                           const std::string& prefix = "") {
   const qs::Trajectory gt = qs::readTumTrajectory(gt_path);
   const auto ate =
       qs::AbsoluteTrajectoryError(qs::AbsoluteTrajectoryError::Params{}).evaluate(gt, estimate);
-  std::printf("ate_rmse_m %.6f\npairs %zu\n", ate.rmse(), ate.pairs());
+  std::printf("%sate_rmse_m %.6f\n%spairs %zu\n", prefix.c_str(), ate.rmse(), prefix.c_str(),
+              ate.pairs());
   try {
     const auto rpe = qs::RelativePoseError(qs::RelativePoseError::Params{}).evaluate(gt, estimate);
-    std::printf("rpe_m_per_s %.6f\n", rpe.translation.rmse);
+    std::printf("%srpe_m_per_s %.6f\n", prefix.c_str(), rpe.translation.rmse);
   } catch (const std::runtime_error& e) {
-    std::printf("rpe_m_per_s nan\n");
+    std::printf("%srpe_m_per_s nan\n", prefix.c_str());
     std::cerr << "run_bag: no RPE: " << e.what() << "\n";
   }
+}
+
+// The points of each label 1..count of a segmentation's label image (index label - 1).
+std::vector<std::vector<Eigen::Vector3f>> pointsPerLabel(
+    const pcl::PointCloud<pcl::PointNormal>& cloud, const cv::Mat& labels, std::size_t count) {
+  std::vector<std::vector<Eigen::Vector3f>> points(count);
+  for (int v = 0; v < labels.rows; ++v) {
+    for (int u = 0; u < labels.cols; ++u) {
+      const unsigned label = labels.at<std::uint16_t>(v, u);
+      if (label >= 1 && label <= count)
+        points[label - 1].push_back(cloud(u, v).getVector3fMap());
+    }
+  }
+  return points;
 }
 
 }  // namespace
@@ -154,6 +180,10 @@ int main(int argc, char** argv) {
     const qs::NormalEstimator normals(normal_params);
     const qs::QuadricSegmenter segmenter(segmenter_params);
     qs::OdometryTracker odometry(odometry_params);
+    // The mapping back-end with its default parameters (no config file yet).
+    qs::QuadricMapper mapper;
+    qs::QuadricReconstruction reconstruction;
+    qs::Trajectory map_trajectory;
 
     std::unique_ptr<qs::FrameSource> source = openInput(o);
     const std::size_t total =
@@ -179,6 +209,8 @@ int main(int argc, char** argv) {
         // Same rule as the nodelets: time going backwards starts a new odom frame.
         std::cerr << "\nrun_bag: time went backwards at " << frame.stamp << ": resetting\n";
         odometry.reset();
+        mapper.reset();
+        reconstruction.clear();
       }
       last_stamp = frame.stamp;
       const qs::CameraIntrinsics& k = frame.intrinsics;
@@ -192,9 +224,9 @@ int main(int argc, char** argv) {
       timer.time("normals", [&] {
         normals.compute(qs::backProject(qs::depthViewOf(frame.depth_m), k, back_projection), cloud);
       });
+      qs::Segmentation segmentation;
       if (!o.odometry_only) {
-        const qs::Segmentation segmentation =
-            timer.time("segmentation", [&] { return segmenter.segment(cloud); });
+        segmentation = timer.time("segmentation", [&] { return segmenter.segment(cloud); });
         for (const qs::QuadricDetection& detection : segmentation.detections)
           ++observations_per_class[qs::toString(detection.shape.quadric_class)];
       }
@@ -203,6 +235,39 @@ int main(int argc, char** argv) {
       ++status_counts[static_cast<int>(result.status)];
       if (odometry.initialized())
         trajectory.push_back({frame.stamp, result.T_odom_camera});
+      if (!o.odometry_only && odometry.initialized()) {
+        const qs::FrameMeasurements measurements =
+            qs::toFrameMeasurements(segmentation, frame.stamp, "camera");
+        qs::OdometryInput odometry_input;
+        odometry_input.T_odom_camera = result.T_odom_camera;
+        const qs::MapperFrameResult mapped =
+            timer.time("mapping", [&] { return mapper.process(measurements, odometry_input); });
+        if (mapped.status != qs::FrameStatus::kOk) {
+          std::cerr << "\nrun_bag: mapper refused frame " << frame.stamp << ": " << mapped.message
+                    << "\n";
+        } else {
+          map_trajectory.push_back({frame.stamp, mapped.T_map_camera});
+          // Reconstruction: the supporting points of the keyframes' landmark observations.
+          if (mapped.keyframe) {
+            timer.time("reconstruction", [&] {
+              const auto points =
+                  pointsPerLabel(cloud, segmentation.labels, segmentation.detections.size());
+              for (std::size_t i = 0; i < mapped.update.measurements.size(); ++i) {
+                const qs::MeasurementResult& fate = mapped.update.measurements[i];
+                const int label = measurements.observations[i].label;
+                if ((fate.fate != qs::MeasurementFate::kLandmark &&
+                     fate.fate != qs::MeasurementFate::kPromoted) ||
+                    label < 1 || label > static_cast<int>(points.size()))
+                  continue;
+                const auto landmark = mapper.map().landmarks().find(fate.id);
+                if (landmark != mapper.map().landmarks().end())
+                  reconstruction.addPoints(fate.id, landmark->second.quadric_map,
+                                           mapped.T_map_camera, points[label - 1]);
+              }
+            });
+          }
+        }
+      }
       if (!o.quiet && (frames % 30 == 0 || frames == total)) {
         const double elapsed =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -233,8 +298,32 @@ int main(int argc, char** argv) {
     std::fputs(timer.table().c_str(), stdout);
     std::printf("trajectory %s/trajectory.txt\ntiming %s/timing.json\n", o.out_dir.c_str(),
                 o.out_dir.c_str());
-    if (!o.gt_path.empty())
+    if (!o.odometry_only) {
+      qs::writeTumTrajectory(map_trajectory, o.out_dir + "/trajectory_map.txt",
+                             "quadric_slam run_bag: camera optical frame in the map frame");
+      const std::vector<qs::QuadricLandmark> landmarks = mapper.landmarks();
+      qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"), o.out_dir + "/map.yaml");
+      std::map<int, qs::QuadricModel> surfaces;
+      std::map<std::string, int> per_class;
+      for (const qs::QuadricLandmark& landmark : landmarks) {
+        surfaces[landmark.id] = landmark.quadric_map;
+        ++per_class[qs::toString(landmark.quadric_map.quadricClass())];
+      }
+      const pcl::PointCloud<pcl::PointXYZL> points = reconstruction.cloud(surfaces);
+      if (!points.empty())
+        pcl::io::savePCDFileBinary(o.out_dir + "/reconstruction.pcd", points);
+      std::printf("map landmarks %zu:", landmarks.size());
+      for (const auto& [name, count] : per_class)
+        std::printf(" %s %d", name.c_str(), count);
+      std::printf("\nreconstruction points %zu\n", points.size());
+      std::printf("map %s/map.yaml\ntrajectory_map %s/trajectory_map.txt\n", o.out_dir.c_str(),
+                  o.out_dir.c_str());
+    }
+    if (!o.gt_path.empty()) {
       printTrajectoryErrors(o.gt_path, trajectory);
+      if (!o.odometry_only)
+        printTrajectoryErrors(o.gt_path, map_trajectory, "map_");
+    }
   } catch (const std::exception& e) {
     std::cerr << "\nrun_bag: " << e.what() << "\n";
     return 1;

@@ -1,0 +1,17 @@
+// The mapper's landmarks as the map schema (io/map_yaml.h), for saved maps and their evaluation.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "quadric_slam/io/map_yaml.h"
+#include "quadric_slam/mapping/landmark.h"
+
+namespace quadric_slam {
+
+// One entry per landmark: id, class (a general quadric with the ellipsoid signature is written as
+// "ellipsoid"), observation count, T_map_quadric, scale and the human-readable shape of its class.
+MapFile mapFileFromLandmarks(const std::vector<QuadricLandmark>& landmarks,
+                             const std::string& frame_id);
+
+}  // namespace quadric_slam

@@ -1,0 +1,29 @@
+#include "quadric_slam/io/landmark_map_file.h"
+
+#include "quadric_slam/geometry/quadric_class.h"
+#include "quadric_slam/geometry/shapes.h"
+
+namespace quadric_slam {
+
+MapFile mapFileFromLandmarks(const std::vector<QuadricLandmark>& landmarks,
+                             const std::string& frame_id) {
+  MapFile map;
+  map.frame_id = frame_id;
+  for (const QuadricLandmark& landmark : landmarks) {
+    const QuadricModel& quadric = landmark.quadric_map;
+    MapFileQuadric entry;
+    entry.id = landmark.id;
+    entry.quadric_class = toString(quadric.quadricClass());
+    if (quadric.quadricClass() == QuadricClass::kGeneral &&
+        quadric.signature() == Eigen::Vector4d(1, 1, 1, -1))
+      entry.quadric_class = "ellipsoid";
+    entry.observations = landmark.observations;
+    entry.T_map_quadric = quadric.pose();
+    entry.scale = quadric.scale();
+    entry.shape = shapeMap(quadric);
+    map.quadrics.push_back(entry);
+  }
+  return map;
+}
+
+}  // namespace quadric_slam
