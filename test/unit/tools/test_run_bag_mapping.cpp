@@ -1,0 +1,97 @@
+// End to end through the offline runner (the `synth`, `run_bag` and `evaluate` tools built beside
+// this test binary): a short synthetic desk sequence goes through normals, segmentation, odometry
+// and the mapper; the mapped trajectory is as accurate as the odometry, the map holds the scene's
+// primitives without duplicates or spurious landmarks, and the reconstruction is written.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "quadric_slam/io/map_yaml.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path toolDir() {
+  return fs::read_symlink("/proc/self/exe").parent_path();
+}
+
+// Runs a tool of toolDir() and returns its standard output (exit code in *code).
+std::string run(const std::string& tool, const std::string& arguments, int* code) {
+  std::string out;
+  FILE* pipe = popen(((toolDir() / tool).string() + " " + arguments + " 2>/dev/null").c_str(), "r");
+  if (!pipe)
+    return out;
+  std::array<char, 4096> buffer;
+  while (fgets(buffer.data(), buffer.size(), pipe))
+    out += buffer.data();
+  const int status = pclose(pipe);
+  *code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+// The number after the first " key " (or a line starting with "key ") in text; NaN when absent.
+double valueAfter(const std::string& text, const std::string& key) {
+  std::size_t at = text.find("\n" + key + " ");
+  if (at == std::string::npos)
+    at = text.find(" " + key + " ");
+  return at == std::string::npos ? NAN : std::stod(text.substr(at + key.size() + 2));
+}
+
+}  // namespace
+
+TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
+  for (const char* tool : {"synth", "run_bag", "evaluate"}) {
+    if (!fs::exists(toolDir() / tool))
+      GTEST_SKIP() << tool << " is not built in " << toolDir();
+  }
+  const fs::path dir = fs::path(testing::TempDir()) / "run_bag_mapping";
+  fs::remove_all(dir);
+  int code = -1;
+  run("synth",
+      "--out " + (dir / "sequence").string() +
+          " --seconds 4 --rate 10 --no-bag --seed 2 --threads 1",
+      &code);
+  ASSERT_EQ(code, 0);
+  const std::string runner =
+      run("run_bag",
+          (dir / "sequence").string() + " --out " + (dir / "out").string() + " --gt " +
+              (dir / "sequence/groundtruth.txt").string() + " --quiet",
+          &code);
+  ASSERT_EQ(code, 0) << runner;
+  std::printf("%s", runner.c_str());
+  const double odometry_ate = valueAfter(runner, "ate_rmse_m");
+  const double map_ate = valueAfter(runner, "map_ate_rmse_m");
+  ASSERT_TRUE(std::isfinite(odometry_ate) && std::isfinite(map_ate)) << runner;
+  // Odometry on this easy scene is millimetre-accurate: the mapper must not spoil it.
+  EXPECT_LT(map_ate, 0.01);
+  EXPECT_LT(map_ate, odometry_ate + 0.002);
+  EXPECT_EQ(valueAfter(runner, "map_pairs"), 40);
+  EXPECT_TRUE(fs::exists(dir / "out/reconstruction.pcd"));
+
+  const quadric_slam::MapFile map = quadric_slam::readMapYaml((dir / "out/map.yaml").string());
+  EXPECT_GE(map.quadrics.size(), 6u);
+  for (const auto& quadric : map.quadrics)
+    EXPECT_GE(quadric.observations, 5) << "landmark " << quadric.id << " entered early";
+
+  const std::string scored = run("evaluate",
+                                 "--gt " + (dir / "sequence/groundtruth.txt").string() + " --est " +
+                                     (dir / "out/trajectory_map.txt").string() + " --map " +
+                                     (dir / "out/map.yaml").string() + " --quadrics-gt " +
+                                     (dir / "sequence/quadrics_gt.yaml").string(),
+                                 &code);
+  ASSERT_EQ(code, 0) << scored;
+  const std::size_t summary = scored.find("map_summary ");
+  ASSERT_NE(summary, std::string::npos) << scored;
+  std::printf("%s", scored.substr(summary).c_str());
+  const std::string line = scored.substr(summary, scored.find('\n', summary) - summary);
+  EXPECT_GE(valueAfter(line, "matched"), 6);
+  EXPECT_EQ(valueAfter(line, "duplicates"), 0);
+  EXPECT_EQ(valueAfter(line, "unmatched_estimates"), 0);
+  fs::remove_all(dir);
+}
