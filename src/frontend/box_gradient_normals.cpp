@@ -1,5 +1,7 @@
 #include "quadric_slam/frontend/box_gradient_normals.h"
 
+#include "quadric_slam/frontend/parallel_chunks.h"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -7,25 +9,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <thread>
 #include <vector>
 
 namespace quadric_slam {
 namespace {
-
-// Runs fn(chunk, begin, end) over [0, count) split into `threads` contiguous chunks, one thread
-// each; returns the number of chunks.
-template <typename Fn>
-int forEachChunk(int count, int threads, Fn fn) {
-  threads = std::max(1, std::min(threads, count));
-  std::vector<std::thread> workers;
-  for (int t = 1; t < threads; ++t)
-    workers.emplace_back(fn, t, count * t / threads, count * (t + 1) / threads);
-  fn(0, 0, count / threads);
-  for (auto& worker : workers)
-    worker.join();
-  return threads;
-}
 
 bool hasData(const pcl::PointXYZ& p) {
   const float limit = static_cast<float>(kBoxGradientMaxCoordinate);

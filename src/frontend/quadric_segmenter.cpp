@@ -11,6 +11,7 @@
 #include "quadric_slam/frontend/boundary_labels.h"
 #include "quadric_slam/frontend/cgal_shape_detector.h"
 #include "quadric_slam/frontend/general_quadric_fit.h"
+#include "quadric_slam/frontend/parallel_chunks.h"
 #include "quadric_slam/geometry/symmetry.h"
 
 namespace quadric_slam {
@@ -435,6 +436,8 @@ void QuadricSegmenter::Params::validate() const {
               str(min_range) + ", " + str(max_range));
   require(decimation >= 1 && decimation <= 8,
           "decimation must be in [1, 8], got " + std::to_string(decimation));
+  require(threads >= 1 && threads <= 64,
+          "threads must be in [1, 64], got " + std::to_string(threads));
   require(boundary_rings >= 0 && boundary_rings <= 10,
           "boundary_rings must be in [0, 10], got " + std::to_string(boundary_rings));
   planes.validate();
@@ -756,51 +759,79 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
                                 ? p.planes.max_normal_angle
                                 : p.curved_max_normal_angle);
   }
+  // Per-chunk tallies of the labelled points (rows split over threads), merged afterwards.
+  struct Tally {
+    std::vector<int> count;
+    std::vector<Eigen::Vector3d> lo, hi;
+    std::vector<ImageRoi> box;  // x, y min; width, height = max
+  };
+  const int threads = std::max(1, std::min(p.threads, height));
+  std::vector<Tally> tallies(threads);
+  const int cw = coarse.labels.cols, ch = coarse.labels.rows;
+  forEachChunk(height, threads, [&](int chunk, int v_begin, int v_end) {
+    Tally& tally = tallies[chunk];
+    tally.count.assign(n, 0);
+    tally.lo.assign(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
+    tally.hi.assign(n, Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
+    tally.box.assign(n, ImageRoi{width, height, -1, -1});
+    for (int v = v_begin; v < v_end; ++v) {
+      const int cv0 = std::min(v / d, ch - 1), cv1 = std::min(v / d + 1, ch - 1);
+      for (int u = 0; u < width; ++u) {
+        const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
+        if (!validPoint(q, p))
+          continue;
+        const int cu0 = std::min(u / d, cw - 1), cu1 = std::min(u / d + 1, cw - 1);
+        const std::uint16_t candidates[4] = {
+            coarse.labels.at<std::uint16_t>(cv0, cu0), coarse.labels.at<std::uint16_t>(cv0, cu1),
+            coarse.labels.at<std::uint16_t>(cv1, cu0), coarse.labels.at<std::uint16_t>(cv1, cu1)};
+        const Eigen::Vector3d point = pointOf(q);
+        const double threshold =
+            depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
+        int best = 0;
+        double best_distance = threshold;
+        for (int c = 0; c < 4; ++c) {
+          const int label = candidates[c];
+          if (label == 0 || label == best)
+            continue;
+          const PrimitiveShape& shape = coarse.detections[label - 1].shape;
+          const double distance = std::abs(shape.distance(point));
+          if (distance >= best_distance)
+            continue;
+          if (std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
+            continue;
+          best = label;
+          best_distance = distance;
+        }
+        if (best == 0)
+          continue;
+        result.labels.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(best);
+        const int k = best - 1;
+        ++tally.count[k];
+        const Eigen::Vector3d local = T_quadric_camera[k] * point;
+        tally.lo[k] = tally.lo[k].cwiseMin(local);
+        tally.hi[k] = tally.hi[k].cwiseMax(local);
+        ImageRoi& box = tally.box[k];
+        box.x_offset = std::min(box.x_offset, u);
+        box.y_offset = std::min(box.y_offset, v);
+        box.width = std::max(box.width, u);
+        box.height = std::max(box.height, v);
+      }
+    }
+  });
   std::vector<int> count(n, 0);
   std::vector<Eigen::Vector3d> lo(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
   std::vector<Eigen::Vector3d> hi(n,
                                   Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
-  std::vector<ImageRoi> box(n, ImageRoi{width, height, -1, -1});  // x, y min; width, height = max
-  const int cw = coarse.labels.cols, ch = coarse.labels.rows;
-  for (int v = 0; v < height; ++v) {
-    const int cv0 = std::min(v / d, ch - 1), cv1 = std::min(v / d + 1, ch - 1);
-    for (int u = 0; u < width; ++u) {
-      const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
-      if (!validPoint(q, p))
-        continue;
-      const int cu0 = std::min(u / d, cw - 1), cu1 = std::min(u / d + 1, cw - 1);
-      const std::uint16_t candidates[4] = {
-          coarse.labels.at<std::uint16_t>(cv0, cu0), coarse.labels.at<std::uint16_t>(cv0, cu1),
-          coarse.labels.at<std::uint16_t>(cv1, cu0), coarse.labels.at<std::uint16_t>(cv1, cu1)};
-      const Eigen::Vector3d point = pointOf(q);
-      const double threshold = depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
-      int best = 0;
-      double best_distance = threshold;
-      for (int c = 0; c < 4; ++c) {
-        const int label = candidates[c];
-        if (label == 0 || label == best)
-          continue;
-        const PrimitiveShape& shape = coarse.detections[label - 1].shape;
-        const double distance = std::abs(shape.distance(point));
-        if (distance >= best_distance)
-          continue;
-        if (std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
-          continue;
-        best = label;
-        best_distance = distance;
-      }
-      if (best == 0)
-        continue;
-      result.labels.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(best);
-      const int k = best - 1;
-      ++count[k];
-      const Eigen::Vector3d local = T_quadric_camera[k] * point;
-      lo[k] = lo[k].cwiseMin(local);
-      hi[k] = hi[k].cwiseMax(local);
-      box[k].x_offset = std::min(box[k].x_offset, u);
-      box[k].y_offset = std::min(box[k].y_offset, v);
-      box[k].width = std::max(box[k].width, u);
-      box[k].height = std::max(box[k].height, v);
+  std::vector<ImageRoi> box(n, ImageRoi{width, height, -1, -1});
+  for (const Tally& tally : tallies) {
+    for (int k = 0; k < n; ++k) {
+      count[k] += tally.count[k];
+      lo[k] = lo[k].cwiseMin(tally.lo[k]);
+      hi[k] = hi[k].cwiseMax(tally.hi[k]);
+      box[k].x_offset = std::min(box[k].x_offset, tally.box[k].x_offset);
+      box[k].y_offset = std::min(box[k].y_offset, tally.box[k].y_offset);
+      box[k].width = std::max(box[k].width, tally.box[k].width);
+      box[k].height = std::max(box[k].height, tally.box[k].height);
     }
   }
   // Keep the detections with support, renumbered 1..m.

@@ -36,6 +36,7 @@ const std::vector<Entry>& table() {
       real("max_range", [](Params& p) -> double& { return p.max_range; }),
       integer("decimation", [](Params& p) -> int& { return p.decimation; }),
       integer("boundary_rings", [](Params& p) -> int& { return p.boundary_rings; }),
+      integer("threads", [](Params& p) -> int& { return p.threads; }),
       real("plane_max_normal_angle",
            [](Params& p) -> double& { return p.planes.max_normal_angle; }),
       real("distance_factor", [](Params& p) -> double& { return p.planes.distance_factor; }),

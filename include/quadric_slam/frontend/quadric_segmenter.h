@@ -82,6 +82,8 @@ class QuadricSegmenter {
     // segment whose surface they fit, up to this many pixels out (frontend/boundary_labels.h),
     // [0, 10]; 0 = off. Default 3.
     int boundary_rings = 3;
+    // Worker threads of the full-resolution labelling (decimation > 1), [1, 64]. Default 2.
+    int threads = 2;
     // Planes (region growing); its min_points is in points of the cloud grid.
     PlaneRegionGrower::Params planes;
     // Curved shapes.
