@@ -165,14 +165,19 @@ class SummedAreaRing {
 
 }  // namespace
 
-void computeBoxGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
-                               const BoxGradientSettings& settings,
-                               pcl::PointCloud<pcl::PointNormal>& out) {
-  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+void shapeNormalsOutput(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                        pcl::PointCloud<pcl::PointNormal>& out) {
   if (out.width != cloud.width || out.height != cloud.height || out.size() != cloud.size())
     out = pcl::PointCloud<pcl::PointNormal>(cloud.width, cloud.height);
   out.header = cloud.header;
   out.is_dense = false;
+}
+
+void computeBoxGradientNormals(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                               const BoxGradientSettings& settings,
+                               pcl::PointCloud<pcl::PointNormal>& out) {
+  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+  shapeNormalsOutput(cloud, out);
   if (cloud.empty())
     return;
 

@@ -78,10 +78,7 @@ void NormalEstimator::compute(const pcl::PointCloud<pcl::PointXYZ>& cloud,
     computeBoxGradientNormals(cloud, settings, out);
     return;
   }
-  if (out.width != cloud.width || out.height != cloud.height || out.size() != cloud.size())
-    out = pcl::PointCloud<pcl::PointNormal>(cloud.width, cloud.height);
-  out.header = cloud.header;
-  out.is_dense = false;
+  shapeNormalsOutput(cloud, out);
   if (cloud.empty())
     return;
   for (std::size_t i = 0; i < cloud.size(); ++i) {

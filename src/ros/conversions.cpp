@@ -10,6 +10,12 @@
 namespace quadric_slam {
 namespace {
 
+Eigen::Vector3d fromPointMsg(const geometry_msgs::Point& msg) {
+  return {msg.x, msg.y, msg.z};
+}
+
+}  // namespace
+
 geometry_msgs::Point toPointMsg(const Eigen::Vector3d& p) {
   geometry_msgs::Point msg;
   msg.x = p.x();
@@ -17,12 +23,6 @@ geometry_msgs::Point toPointMsg(const Eigen::Vector3d& p) {
   msg.z = p.z();
   return msg;
 }
-
-Eigen::Vector3d fromPointMsg(const geometry_msgs::Point& msg) {
-  return {msg.x, msg.y, msg.z};
-}
-
-}  // namespace
 
 geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose) {
   geometry_msgs::Pose msg;

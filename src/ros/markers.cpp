@@ -1,7 +1,5 @@
 #include "quadric_slam/ros/markers.h"
 
-#include <geometry_msgs/Point.h>
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -26,14 +24,6 @@ void extentOrDefault(const QuadricLandmark& landmark, double size, Eigen::Vector
     lower = Eigen::Vector3d::Constant(-size / 2);
     upper = Eigen::Vector3d::Constant(size / 2);
   }
-}
-
-geometry_msgs::Point pointMsg(const Eigen::Vector3d& p) {
-  geometry_msgs::Point msg;
-  msg.x = p.x();
-  msg.y = p.y();
-  msg.z = p.z();
-  return msg;
 }
 
 visualization_msgs::Marker baseMarker(const QuadricLandmark& landmark,
@@ -64,7 +54,7 @@ void addConeMesh(double z0, double z1, double tan_half_angle, int segments,
                           p10 = conePoint(z1, tan_half_angle, a0),
                           p11 = conePoint(z1, tan_half_angle, a1);
     for (const Eigen::Vector3d& p : {p00, p10, p11, p00, p11, p01})
-      marker.points.push_back(pointMsg(p));
+      marker.points.push_back(toPointMsg(p));
   }
 }
 
@@ -208,7 +198,7 @@ visualization_msgs::MarkerArray quadricMarkers(const std::vector<QuadricLandmark
     label.action = visualization_msgs::Marker::ADD;
     label.type = visualization_msgs::Marker::TEXT_VIEW_FACING;
     label.text = toString(landmark.quadric_map.quadricClass()) + " " + std::to_string(landmark.id);
-    label.pose.position = pointMsg(centre_map);
+    label.pose.position = toPointMsg(centre_map);
     label.pose.orientation.w = 1.0;
     label.scale.z = style.label_height;
     label.color.r = label.color.g = label.color.b = label.color.a = 1.0f;

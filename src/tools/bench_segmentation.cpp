@@ -24,6 +24,7 @@
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/frontend/segmentation_input.h"
 #include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/io/frame_source.h"
 
 namespace qs = quadric_slam;
 namespace fs = std::filesystem;
@@ -129,11 +130,7 @@ std::vector<Frame> syntheticFrames(int count, const qs::NormalEstimator& normals
     qs::RenderParams render;
     render.seed = 100 + i;
     const qs::RenderedFrame rendered = qs::renderPrimitives(scene, k, render);
-    qs::DepthImageView<float> view;
-    view.data = rendered.depth.data;
-    view.width = rendered.depth.cols;
-    view.height = rendered.depth.rows;
-    view.row_step_bytes = rendered.depth.step[0];
+    const qs::DepthImageView<float> view = qs::depthViewOf(rendered.depth);
     frames.push_back({"synthetic_" + std::to_string(i),
                       normals.compute(qs::backProject(view, k, qs::BackProjectionParams()))});
   }

@@ -25,6 +25,7 @@
 #include "quadric_slam/frontend/segmenter_params.h"
 #include "quadric_slam/geometry/shapes.h"
 #include "quadric_slam/io/depth_png.h"
+#include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/io/trajectory_io.h"
 
@@ -100,11 +101,7 @@ int main(int argc, char** argv) {
         throw std::runtime_error("cannot read the label image labels/" + name);
       k.width = depth.cols;
       k.height = depth.rows;
-      qs::DepthImageView<float> view;
-      view.data = depth.data;
-      view.width = depth.cols;
-      view.height = depth.rows;
-      view.row_step_bytes = depth.step[0];
+      const qs::DepthImageView<float> view = qs::depthViewOf(depth);
       const auto cloud = normals.compute(qs::backProject(view, k, qs::BackProjectionParams()));
       const qs::Segmentation segmentation = segmenter.segment(cloud);
       cv::Mat valid = depth == depth;  // not NaN

@@ -16,6 +16,7 @@
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/primitive_scene_renderer.h"
+#include "quadric_slam/io/frame_source.h"
 
 namespace qs = quadric_slam;
 
@@ -42,11 +43,7 @@ pcl::PointCloud<pcl::PointNormal> sceneCloud() {
       qs::PrimitiveShape::cylinder(Eigen::Vector3d(0.3, 0.8, 1.8), Eigen::Vector3d(0, -1, 0), 0.09);
   scene[3].axis_max = 0.55;
   const qs::RenderedFrame frame = qs::renderPrimitives(scene, kinect(), qs::RenderParams());
-  qs::DepthImageView<float> view;
-  view.data = frame.depth.data;
-  view.width = frame.depth.cols;
-  view.height = frame.depth.rows;
-  view.row_step_bytes = frame.depth.step[0];
+  const qs::DepthImageView<float> view = qs::depthViewOf(frame.depth);
   return qs::NormalEstimator(qs::NormalEstimator::Params())
       .compute(qs::backProject(view, kinect(), qs::BackProjectionParams()));
 }

@@ -33,6 +33,11 @@ struct BoxGradientSettings {
 // fixed-point scale is chosen from the largest coordinate in the frame.
 constexpr double kBoxGradientMaxCoordinate = 1000.0;
 
+// Gives out the input's size (its storage reused when it already has it), header and is_dense =
+// false: the output shape of every normal estimation method.
+void shapeNormalsOutput(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                        pcl::PointCloud<pcl::PointNormal>& out);
+
 // Fills out (resized to the input's size, its storage reused when it already has that size) with
 // the input's points, their normals facing the sensor origin, and curvature NaN (not estimated by
 // this method). Pixels without data, on an edge, or without room for a third of the smoothing

@@ -3,6 +3,7 @@
 // QuadricMeasurement vs QuadricObservation, QuadricLandmark vs Quadric.)
 #pragma once
 
+#include <geometry_msgs/Point.h>
 #include <geometry_msgs/Pose.h>
 #include <quadric_slam/Quadric.h>
 #include <quadric_slam/QuadricObservation.h>
@@ -18,6 +19,7 @@
 
 namespace quadric_slam {
 
+geometry_msgs::Point toPointMsg(const Eigen::Vector3d& p);
 geometry_msgs::Pose toPoseMsg(const Eigen::Isometry3d& pose);
 // Throws std::invalid_argument for a non-finite pose or a quaternion far from unit length.
 Eigen::Isometry3d fromPoseMsg(const geometry_msgs::Pose& msg);

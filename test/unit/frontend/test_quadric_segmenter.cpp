@@ -15,6 +15,7 @@
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/primitive_scene_renderer.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
+#include "quadric_slam/io/frame_source.h"
 
 namespace qs = quadric_slam;
 using qs::PrimitiveShape;
@@ -55,11 +56,7 @@ std::vector<qs::ScenePrimitive> deskScene(const Eigen::Isometry3d& T_camera_scen
 }
 
 pcl::PointCloud<pcl::PointNormal> cloudWithNormals(const cv::Mat& depth) {
-  qs::DepthImageView<float> view;
-  view.data = depth.data;
-  view.width = depth.cols;
-  view.height = depth.rows;
-  view.row_step_bytes = depth.step[0];
+  const qs::DepthImageView<float> view = qs::depthViewOf(depth);
   const pcl::PointCloud<pcl::PointXYZ> cloud =
       qs::backProject(view, kinect(), qs::BackProjectionParams());
   return qs::NormalEstimator(qs::NormalEstimator::Params()).compute(cloud);

@@ -24,6 +24,7 @@
 #include "quadric_slam/frontend/segmentation_score.h"
 #include "quadric_slam/geometry/shapes.h"
 #include "quadric_slam/io/depth_png.h"
+#include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/io/trajectory_io.h"
 
@@ -74,11 +75,7 @@ TEST(QuadricSegmenterSynth, DeskSequencePrimitivesFoundWithFewSpuriousDetections
     ASSERT_EQ(truth.type(), CV_16UC1);
     k.width = depth.cols;
     k.height = depth.rows;
-    qs::DepthImageView<float> view;
-    view.data = depth.data;
-    view.width = depth.cols;
-    view.height = depth.rows;
-    view.row_step_bytes = depth.step[0];
+    const qs::DepthImageView<float> view = qs::depthViewOf(depth);
     const auto cloud = normals.compute(qs::backProject(view, k, qs::BackProjectionParams()));
     const auto pose = poses.find(std::llround(std::stod(stamp) * 1e6));
     ASSERT_NE(pose, poses.end()) << "no ground-truth pose at " << stamp;
