@@ -20,7 +20,7 @@
 
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/io/pipeline_params.h"
+#include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/params.h"

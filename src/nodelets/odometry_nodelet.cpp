@@ -28,7 +28,7 @@
 #include <sstream>
 #include <string>
 
-#include "quadric_slam/io/pipeline_params.h"
+#include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/params.h"

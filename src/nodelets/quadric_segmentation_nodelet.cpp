@@ -29,7 +29,7 @@
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/frontend/detection_measurement.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
-#include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/pipeline/segmenter_params.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/params.h"

@@ -20,10 +20,10 @@
 
 #include "quadric_slam/frontend/cgal_shape_detector.h"
 #include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/frontend/primitive_scene_renderer.h"
+#include "quadric_slam/sim/primitive_scene_renderer.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
-#include "quadric_slam/frontend/segmentation_input.h"
-#include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/io/segmentation_input.h"
+#include "quadric_slam/pipeline/segmenter_params.h"
 #include "quadric_slam/io/frame_source.h"
 
 namespace qs = quadric_slam;
@@ -129,7 +129,7 @@ std::vector<Frame> syntheticFrames(int count, const qs::NormalEstimator& normals
       p.shape = p.shape.transformed(T);
     qs::RenderParams render;
     render.seed = 100 + i;
-    const qs::RenderedFrame rendered = qs::renderPrimitives(scene, k, render);
+    const qs::PrimitiveRendering rendered = qs::renderPrimitives(scene, k, render);
     const qs::DepthImageView<float> view = qs::depthViewOf(rendered.depth);
     frames.push_back({"synthetic_" + std::to_string(i),
                       normals.compute(qs::backProject(view, k, qs::BackProjectionParams()))});

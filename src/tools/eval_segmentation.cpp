@@ -22,7 +22,7 @@
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/frontend/segmentation_score.h"
-#include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/pipeline/segmenter_params.h"
 #include "quadric_slam/geometry/shapes.h"
 #include "quadric_slam/io/depth_png.h"
 #include "quadric_slam/io/frame_source.h"

@@ -1,12 +1,15 @@
-// run_bag: the offline runner. Pushes every frame of a TUM rosbag or TUM folder through the same
-// core classes the nodelets use (back-projection + normals, quadric segmentation, odometry,
-// mapping), with the same config/*.yaml parameters, as fast as the machine allows: no master, no
-// real-time pacing. Writes DIR/trajectory.txt (TUM format, camera optical frame in the odom frame),
-// DIR/timing.json (per-stage median/p95/max) and, unless --odometry-only, the mapper's
-// DIR/trajectory_map.txt (camera in the map frame), DIR/map.yaml (the landmarks, map schema) and
-// DIR/reconstruction.pcd (landmark points projected onto their surfaces, label = landmark id);
-// with --gt prints the ATE and RPE of the odometry (ate_rmse_m ...) and of the mapper
-// (map_ate_rmse_m ...).
+// run_bag: the offline runner, a thin shell over the pipeline class QuadricSlam
+// (pipeline/quadric_slam.h): every frame of a TUM rosbag or TUM folder through normals, quadric
+// segmentation, odometry and mapping, with the same config/*.yaml parameters as the nodelets, as
+// fast as the machine allows (no master, no real-time pacing). Writes
+//   DIR/trajectory.txt       the SLAM estimate, camera optical frame in the map frame (with
+//                            --odometry-only: the odometry, camera in the odom frame)
+//   DIR/trajectory_odom.txt  the odometry, camera optical frame in the odom frame
+//   DIR/timing.json          per-stage median/p95/max
+//   DIR/map.yaml             the landmarks (map schema), unless --odometry-only
+//   DIR/reconstruction.pcd   landmark points projected onto their surfaces (label = landmark id)
+// With --gt prints the ATE and RPE of the odometry (ate_rmse_m ...) and of SLAM (map_ate_rmse_m
+// ...).
 //
 //   run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR] [--max-frames N]
 //           [--intrinsics fx,fy,cx,cy] [--quiet]
@@ -22,23 +25,14 @@
 #include <sstream>
 #include <string>
 
-#include "quadric_slam/eval/stage_timing.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
-#include "quadric_slam/frontend/detection_measurement.h"
-#include "quadric_slam/frontend/frame.h"
-#include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/frontend/quadric_segmenter.h"
-#include "quadric_slam/frontend/segmenter_params.h"
-#include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/io/landmark_map_file.h"
 #include "quadric_slam/io/map_yaml.h"
-#include "quadric_slam/io/pipeline_params.h"
 #include "quadric_slam/io/trajectory_io.h"
 #include "quadric_slam/io/tum_folder_reader.h"
-#include "quadric_slam/mapping/quadric_mapper.h"
-#include "quadric_slam/mapping/reconstruction.h"
-#include "quadric_slam/odometry/odometry_tracker.h"
+#include "quadric_slam/pipeline/quadric_slam.h"
 #include "quadric_slam/ros/tum_bag_reader.h"
+
 
 namespace qs = quadric_slam;
 namespace fs = std::filesystem;
@@ -124,10 +118,6 @@ std::unique_ptr<qs::FrameSource> openInput(const Options& o) {
   throw std::runtime_error("INPUT " + o.input + " is neither a TUM folder nor a bag file");
 }
 
-qs::YamlParamReader configFile(const Options& o, const std::string& name) {
-  return qs::YamlParamReader::fromFile(o.config_dir + "/" + name);
-}
-
 // Prints <prefix>ate_rmse_m, <prefix>pairs and <prefix>rpe_m_per_s.
 void printTrajectoryErrors(const std::string& gt_path, const qs::Trajectory& estimate,
                            const std::string& prefix = "") {
@@ -145,20 +135,6 @@ void printTrajectoryErrors(const std::string& gt_path, const qs::Trajectory& est
   }
 }
 
-// The points of each label 1..count of a segmentation's label image (index label - 1).
-std::vector<std::vector<Eigen::Vector3f>> pointsPerLabel(
-    const pcl::PointCloud<pcl::PointNormal>& cloud, const cv::Mat& labels, std::size_t count) {
-  std::vector<std::vector<Eigen::Vector3f>> points(count);
-  for (int v = 0; v < labels.rows; ++v) {
-    for (int u = 0; u < labels.cols; ++u) {
-      const unsigned label = labels.at<std::uint16_t>(v, u);
-      if (label >= 1 && label <= count)
-        points[label - 1].push_back(cloud(u, v).getVector3fMap());
-    }
-  }
-  return points;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -168,22 +144,9 @@ int main(int argc, char** argv) {
     return usage(problem);
 
   try {
-    qs::ParamLog log;
-    qs::BackProjectionParams back_projection;
-    qs::NormalEstimator::Params normal_params;
-    qs::readNormalEstimationParams(configFile(o, "normal_estimation.yaml"), back_projection,
-                                   normal_params, log);
-    qs::OdometryTracker::Params odometry_params;
-    qs::readOdometryParams(configFile(o, "odometry.yaml"), odometry_params, log);
-    qs::QuadricSegmenter::Params segmenter_params;
-    qs::readSegmentationParams(configFile(o, "segmentation.yaml"), segmenter_params, log);
-    const qs::NormalEstimator normals(normal_params);
-    const qs::QuadricSegmenter segmenter(segmenter_params);
-    qs::OdometryTracker odometry(odometry_params);
-    // The mapping back-end with its default parameters (no config file yet).
-    qs::QuadricMapper mapper;
-    qs::QuadricReconstruction reconstruction;
-    qs::Trajectory map_trajectory;
+    qs::SlamParams params = qs::loadSlamParams(o.config_dir);
+    params.mapping_enabled = !o.odometry_only;
+    qs::QuadricSlam slam(params);
 
     std::unique_ptr<qs::FrameSource> source = openInput(o);
     const std::size_t total =
@@ -194,80 +157,32 @@ int main(int argc, char** argv) {
                 << (o.odometry_only ? ", odometry only" : "") << "\n";
     }
 
-    qs::StageTimer timer;
-    qs::Trajectory trajectory;
+    qs::StageTimer read_timer;
+    qs::Trajectory odom_trajectory, map_trajectory;
     int status_counts[3] = {0, 0, 0};
     std::map<std::string, std::size_t> observations_per_class;
     std::size_t frames = 0, skipped = 0;
-    double last_stamp = -1e300;
     const auto start = std::chrono::steady_clock::now();
     qs::RgbdFrame frame;
-    pcl::PointCloud<pcl::PointNormal> cloud;  // storage reused from frame to frame
-    while (frames < total && timer.time("read", [&] { return source->next(frame); })) {
+    while (frames < total && read_timer.time("read", [&] { return source->next(frame); })) {
       ++frames;
-      if (frame.stamp <= last_stamp) {
-        // Same rule as the nodelets: time going backwards starts a new odom frame.
-        std::cerr << "\nrun_bag: time went backwards at " << frame.stamp << ": resetting\n";
-        odometry.reset();
-        mapper.reset();
-        reconstruction.clear();
-      }
-      last_stamp = frame.stamp;
-      const qs::CameraIntrinsics& k = frame.intrinsics;
-      const std::string size_problem =
-          qs::imageSizeProblem(k, frame.depth_m.cols, frame.depth_m.rows);
-      if (!size_problem.empty()) {
-        std::cerr << "\nrun_bag: skipping frame " << frame.stamp << ": " << size_problem << "\n";
+      const qs::SlamFrameResult result = slam.process(frame);
+      if (result.reset)
+        std::cerr << "\nrun_bag: time went backwards at " << frame.stamp << ": reset\n";
+      if (!result.processed) {
+        std::cerr << "\nrun_bag: skipping frame " << frame.stamp << ": " << result.message << "\n";
         ++skipped;
         continue;
       }
-      timer.time("normals", [&] {
-        normals.compute(qs::backProject(qs::depthViewOf(frame.depth_m), k, back_projection), cloud);
-      });
-      qs::Segmentation segmentation;
-      if (!o.odometry_only) {
-        segmentation = timer.time("segmentation", [&] { return segmenter.segment(cloud); });
-        for (const qs::QuadricDetection& detection : segmentation.detections)
-          ++observations_per_class[qs::toString(detection.shape.quadric_class)];
-      }
-      const qs::OdometryTracker::Result result =
-          timer.time("odometry", [&] { return odometry.track(cloud, k, frame.stamp); });
-      ++status_counts[static_cast<int>(result.status)];
-      if (odometry.initialized())
-        trajectory.push_back({frame.stamp, result.T_odom_camera});
-      if (!o.odometry_only && odometry.initialized()) {
-        const qs::FrameMeasurements measurements =
-            qs::toFrameMeasurements(segmentation, frame.stamp, "camera");
-        qs::OdometryInput odometry_input;
-        odometry_input.T_odom_camera = result.T_odom_camera;
-        const qs::MapperFrameResult mapped =
-            timer.time("mapping", [&] { return mapper.process(measurements, odometry_input); });
-        if (mapped.status != qs::FrameStatus::kOk) {
-          std::cerr << "\nrun_bag: mapper refused frame " << frame.stamp << ": " << mapped.message
-                    << "\n";
-        } else {
-          map_trajectory.push_back({frame.stamp, mapped.T_map_camera});
-          // Reconstruction: the supporting points of the keyframes' landmark observations.
-          if (mapped.keyframe) {
-            timer.time("reconstruction", [&] {
-              const auto points =
-                  pointsPerLabel(cloud, segmentation.labels, segmentation.detections.size());
-              for (std::size_t i = 0; i < mapped.update.measurements.size(); ++i) {
-                const qs::MeasurementResult& fate = mapped.update.measurements[i];
-                const int label = measurements.observations[i].label;
-                if ((fate.fate != qs::MeasurementFate::kLandmark &&
-                     fate.fate != qs::MeasurementFate::kPromoted) ||
-                    label < 1 || label > static_cast<int>(points.size()))
-                  continue;
-                const auto landmark = mapper.map().landmarks().find(fate.id);
-                if (landmark != mapper.map().landmarks().end())
-                  reconstruction.addPoints(fate.id, landmark->second.quadric_map,
-                                           mapped.T_map_camera, points[label - 1]);
-              }
-            });
-          }
-        }
-      }
+      for (const qs::QuadricMeasurement& m : result.measurements.observations)
+        ++observations_per_class[qs::toString(m.quadric_camera.quadricClass())];
+      ++status_counts[static_cast<int>(result.odometry.status)];
+      if (result.tracking)
+        odom_trajectory.push_back({frame.stamp, result.odometry.T_odom_camera});
+      if (result.mapped)
+        map_trajectory.push_back({frame.stamp, result.mapping.T_map_camera});
+      else if (!o.odometry_only && result.tracking)
+        std::cerr << "\nrun_bag: frame " << frame.stamp << ": " << result.message << "\n";
       if (!o.quiet && (frames % 30 == 0 || frames == total)) {
         const double elapsed =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -280,8 +195,15 @@ int main(int argc, char** argv) {
     if (!o.quiet)
       std::fprintf(stderr, "\n");
 
-    qs::writeTumTrajectory(trajectory, o.out_dir + "/trajectory.txt",
+    qs::StageTimer timer = slam.timer();
+    timer.merge(read_timer);
+    const qs::Trajectory& slam_trajectory = o.odometry_only ? odom_trajectory : map_trajectory;
+    qs::writeTumTrajectory(odom_trajectory, o.out_dir + "/trajectory_odom.txt",
                            "quadric_slam run_bag: camera optical frame in the odom frame");
+    qs::writeTumTrajectory(slam_trajectory, o.out_dir + "/trajectory.txt",
+                           o.odometry_only
+                               ? "quadric_slam run_bag: camera optical frame in the odom frame"
+                               : "quadric_slam run_bag: camera optical frame in the map frame");
     std::ofstream(o.out_dir + "/timing.json") << timer.json(frames, wall_s);
 
     std::printf("frames %zu\nskipped %zu\nwall_s %.3f\nfps %.2f\n", frames, skipped, wall_s,
@@ -296,31 +218,26 @@ int main(int argc, char** argv) {
       std::printf("\n");
     }
     std::fputs(timer.table().c_str(), stdout);
-    std::printf("trajectory %s/trajectory.txt\ntiming %s/timing.json\n", o.out_dir.c_str(),
-                o.out_dir.c_str());
+    std::printf("trajectory %s/trajectory.txt\ntrajectory_odom %s/trajectory_odom.txt\n"
+                "timing %s/timing.json\n",
+                o.out_dir.c_str(), o.out_dir.c_str(), o.out_dir.c_str());
     if (!o.odometry_only) {
-      qs::writeTumTrajectory(map_trajectory, o.out_dir + "/trajectory_map.txt",
-                             "quadric_slam run_bag: camera optical frame in the map frame");
-      const std::vector<qs::QuadricLandmark> landmarks = mapper.landmarks();
+      const std::vector<qs::QuadricLandmark> landmarks = slam.mapper().landmarks();
       qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"), o.out_dir + "/map.yaml");
-      std::map<int, qs::QuadricModel> surfaces;
       std::map<std::string, int> per_class;
-      for (const qs::QuadricLandmark& landmark : landmarks) {
-        surfaces[landmark.id] = landmark.quadric_map;
+      for (const qs::QuadricLandmark& landmark : landmarks)
         ++per_class[qs::toString(landmark.quadric_map.quadricClass())];
-      }
-      const pcl::PointCloud<pcl::PointXYZL> points = reconstruction.cloud(surfaces);
+      const pcl::PointCloud<pcl::PointXYZL> points = slam.reconstructionCloud();
       if (!points.empty())
         pcl::io::savePCDFileBinary(o.out_dir + "/reconstruction.pcd", points);
       std::printf("map landmarks %zu:", landmarks.size());
       for (const auto& [name, count] : per_class)
         std::printf(" %s %d", name.c_str(), count);
       std::printf("\nreconstruction points %zu\n", points.size());
-      std::printf("map %s/map.yaml\ntrajectory_map %s/trajectory_map.txt\n", o.out_dir.c_str(),
-                  o.out_dir.c_str());
+      std::printf("map %s/map.yaml\n", o.out_dir.c_str());
     }
     if (!o.gt_path.empty()) {
-      printTrajectoryErrors(o.gt_path, trajectory);
+      printTrajectoryErrors(o.gt_path, odom_trajectory);
       if (!o.odometry_only)
         printTrajectoryErrors(o.gt_path, map_trajectory, "map_");
     }

@@ -26,8 +26,8 @@
 
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
-#include "quadric_slam/frontend/segmentation_input.h"
-#include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/io/segmentation_input.h"
+#include "quadric_slam/pipeline/segmenter_params.h"
 
 namespace qs = quadric_slam;
 

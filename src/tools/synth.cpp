@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "quadric_slam/io/map_yaml.h"
-#include "quadric_slam/io/scene.h"
+#include "quadric_slam/sim/scene_yaml.h"
 #include "quadric_slam/ros/tum_bag_writer.h"
 #include "quadric_slam/sim/renderer.h"
 #include "quadric_slam/sim/sequence_generator.h"

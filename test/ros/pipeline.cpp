@@ -18,7 +18,7 @@
 #include <set>
 
 #include "quadric_slam/eval/trajectory_metrics.h"
-#include "quadric_slam/io/scene.h"
+#include "quadric_slam/sim/scene_yaml.h"
 #include "quadric_slam/ros/tum_bag_writer.h"
 #include "quadric_slam/sim/renderer.h"
 #include "quadric_slam/sim/sequence_generator.h"

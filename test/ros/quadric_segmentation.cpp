@@ -15,7 +15,7 @@
 
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/frontend/primitive_scene_renderer.h"
+#include "quadric_slam/sim/primitive_scene_renderer.h"
 #include "quadric_slam/io/frame_source.h"
 
 namespace qs = quadric_slam;

@@ -37,6 +37,11 @@ class StageTimer {
     return fn();
   }
   void add(const std::string& stage, double duration_ms) { stages_[stage].push_back(duration_ms); }
+  // Appends another timer's durations (e.g. the reader's to the pipeline's).
+  void merge(const StageTimer& other) {
+    for (const auto& [stage, durations] : other.stages_)
+      stages_[stage].insert(stages_[stage].end(), durations.begin(), durations.end());
+  }
 
   std::map<std::string, TimingSummary> summaries() const;
   // {"frames": N, "wall_s": X, "stages": {"name": {"median_ms": .., "p95_ms": .., "max_ms": ..,

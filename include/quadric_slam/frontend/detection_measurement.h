@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/types/observation.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 
 namespace quadric_slam {

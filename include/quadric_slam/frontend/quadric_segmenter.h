@@ -25,7 +25,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "quadric_slam/frontend/observation.h"  // ImageRoi
+#include "quadric_slam/types/observation.h"  // ImageRoi
 #include "quadric_slam/frontend/plane_region_grower.h"
 #include "quadric_slam/frontend/primitive_shape.h"
 #include "quadric_slam/frontend/shape_refiner.h"

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/types/camera_intrinsics.h"
 #include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/io/trajectory_io.h"
 

@@ -26,7 +26,7 @@
 #include <limits>
 #include <vector>
 
-#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/quadric.h"
 #include "quadric_slam/geometry/se3.h"
 #include "quadric_slam/mapping/extent_box.h"

@@ -12,7 +12,7 @@
 #include <map>
 #include <vector>
 
-#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/types/observation.h"
 #include "quadric_slam/mapping/association.h"
 #include "quadric_slam/mapping/landmark.h"
 

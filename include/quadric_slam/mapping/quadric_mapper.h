@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/se3.h"
 #include "quadric_slam/mapping/quadric_map.h"
 #include "quadric_slam/mapping/window.h"

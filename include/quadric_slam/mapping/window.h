@@ -31,7 +31,7 @@
 #include <map>
 #include <vector>
 
-#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/se3.h"
 #include "quadric_slam/mapping/quadric_map.h"
 

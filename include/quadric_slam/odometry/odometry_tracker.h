@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/types/camera_intrinsics.h"
 #include "quadric_slam/odometry/point_to_plane_icp.h"
 
 namespace quadric_slam {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/types/camera_intrinsics.h"
 #include "quadric_slam/odometry/pose_math.h"
 
 namespace quadric_slam {

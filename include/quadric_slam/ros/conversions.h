@@ -13,7 +13,7 @@
 #include <Eigen/Geometry>
 #include <vector>
 
-#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/quadric.h"
 #include "quadric_slam/mapping/landmark.h"
 

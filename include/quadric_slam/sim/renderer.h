@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/types/camera_intrinsics.h"
 #include "quadric_slam/sim/kinect_depth_model.h"
 #include "quadric_slam/sim/surfaces.h"
 

@@ -11,7 +11,7 @@
 
 #include "quadric_slam/frontend/detection_measurement.h"
 #include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/frontend/primitive_scene_renderer.h"
+#include "quadric_slam/sim/primitive_scene_renderer.h"
 #include "quadric_slam/frontend/shape_refiner.h"
 #include "quadric_slam/geometry/symmetry.h"
 #include "quadric_slam/io/frame_source.h"
@@ -67,7 +67,7 @@ double quadricValue(const qs::QuadricModel& q, const Eigen::Vector3d& p) {
 }  // namespace
 
 TEST(DetectionMeasurement, SegmenterDetectionsBecomeCoreQuadricsWithTheirExtentBoxes) {
-  const qs::RenderedFrame frame = qs::renderPrimitives(deskScene(), kinect(), qs::RenderParams());
+  const qs::PrimitiveRendering frame = qs::renderPrimitives(deskScene(), kinect(), qs::RenderParams());
   const pcl::PointCloud<pcl::PointNormal> cloud = cloudWithNormals(frame.depth);
   const qs::Segmentation seg = qs::QuadricSegmenter(qs::QuadricSegmenter::Params()).segment(cloud);
   ASSERT_GE(seg.detections.size(), 5u);

@@ -13,7 +13,7 @@
 #include <map>
 
 #include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/frontend/primitive_scene_renderer.h"
+#include "quadric_slam/sim/primitive_scene_renderer.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/io/frame_source.h"
 
@@ -87,7 +87,7 @@ void checkScene(const Eigen::Isometry3d& T_camera_scene, unsigned seed) {
   const std::vector<qs::ScenePrimitive> scene = deskScene(T_camera_scene);
   qs::RenderParams render;
   render.seed = seed;
-  const qs::RenderedFrame frame = qs::renderPrimitives(scene, kinect(), render);
+  const qs::PrimitiveRendering frame = qs::renderPrimitives(scene, kinect(), render);
   const qs::QuadricSegmenter segmenter{qs::QuadricSegmenter::Params()};
   const qs::Segmentation result = segmenter.segment(cloudWithNormals(frame.depth));
   // QS_DEBUG_DIR=dir writes the truth and the segmentation as pictures, and lists detections.
@@ -178,7 +178,7 @@ TEST(QuadricSegmenter, FindsThemInATiltedView) {
 }
 
 TEST(QuadricSegmenter, LabelsAreConsistentWithDetections) {
-  const qs::RenderedFrame frame =
+  const qs::PrimitiveRendering frame =
       qs::renderPrimitives(deskScene(Eigen::Isometry3d::Identity()), kinect(), qs::RenderParams());
   const qs::Segmentation result =
       qs::QuadricSegmenter(qs::QuadricSegmenter::Params()).segment(cloudWithNormals(frame.depth));

@@ -18,7 +18,7 @@
 
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
-#include "quadric_slam/frontend/segmentation_input.h"
+#include "quadric_slam/io/segmentation_input.h"
 
 namespace qs = quadric_slam;
 using qs::QuadricClass;

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "../test_support.h"
-#include "quadric_slam/frontend/observation.h"
+#include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/quadric.h"
 #include "quadric_slam/geometry/quadric_classes.h"
 #include "quadric_slam/geometry/shapes.h"

@@ -81,7 +81,7 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
 
   const std::string scored = run("evaluate",
                                  "--gt " + (dir / "sequence/groundtruth.txt").string() + " --est " +
-                                     (dir / "out/trajectory_map.txt").string() + " --map " +
+                                     (dir / "out/trajectory.txt").string() + " --map " +
                                      (dir / "out/map.yaml").string() + " --quadrics-gt " +
                                      (dir / "sequence/quadrics_gt.yaml").string(),
                                  &code);

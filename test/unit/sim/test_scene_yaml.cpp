@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "quadric_slam/io/scene.h"
+#include "quadric_slam/sim/scene_yaml.h"
 #include "quadric_slam/sim/surfaces.h"
 
 using namespace quadric_slam;

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "quadric_slam/io/pipeline_params.h"
+#include "quadric_slam/pipeline/pipeline_params.h"
 
 namespace qs = quadric_slam;
 

@@ -7,6 +7,8 @@
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/io/param_reader.h"
+#include "quadric_slam/mapping/quadric_mapper.h"
+#include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
 
 namespace quadric_slam {
@@ -24,5 +26,11 @@ void readNormalEstimationParams(const ParamReader& reader, BackProjectionParams&
 // max_rotation_from_guess, keyframe_translation, keyframe_rotation, keyframe_min_overlap,
 // constant_velocity, lost_frames_before_new_keyframe.
 void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& params, ParamLog& log);
+
+// config/mapping.yaml: the mapper (candidates, association gate, sliding window, keyframes,
+// odometry noise model) and the reconstruction (reconstruction_*). Key names are listed, with
+// meaning, unit and default, in config/mapping.yaml.
+void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
+                       QuadricReconstruction::Params& reconstruction, ParamLog& log);
 
 }  // namespace quadric_slam

@@ -7,7 +7,7 @@
 #include <set>
 #include <string>
 
-#include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/pipeline/segmenter_params.h"
 
 namespace qs = quadric_slam;
 

@@ -1,4 +1,4 @@
-#include "quadric_slam/frontend/segmenter_params.h"
+#include "quadric_slam/pipeline/segmenter_params.h"
 
 #include <yaml-cpp/yaml.h>
 

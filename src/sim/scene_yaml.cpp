@@ -1,4 +1,4 @@
-#include "quadric_slam/io/scene.h"
+#include "quadric_slam/sim/scene_yaml.h"
 
 #include <yaml-cpp/yaml.h>
 

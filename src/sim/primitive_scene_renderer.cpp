@@ -1,4 +1,4 @@
-#include "quadric_slam/frontend/primitive_scene_renderer.h"
+#include "quadric_slam/sim/primitive_scene_renderer.h"
 
 #include <cmath>
 #include <limits>
@@ -85,9 +85,9 @@ double intersect(const ScenePrimitive& prim, const Eigen::Vector3d& ray) {
 
 }  // namespace
 
-RenderedFrame renderPrimitives(const std::vector<ScenePrimitive>& scene, const CameraIntrinsics& k,
+PrimitiveRendering renderPrimitives(const std::vector<ScenePrimitive>& scene, const CameraIntrinsics& k,
                                const RenderParams& params) {
-  RenderedFrame frame;
+  PrimitiveRendering frame;
   frame.depth =
       cv::Mat(k.height, k.width, CV_32FC1, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
   frame.truth = cv::Mat::zeros(k.height, k.width, CV_16UC1);

@@ -23,7 +23,7 @@ struct ScenePrimitive {
   double plane_half_size = 0.0;
 };
 
-struct RenderedFrame {
+struct PrimitiveRendering {
   cv::Mat depth;  // CV_32FC1 metres, NaN = no surface
   cv::Mat truth;  // CV_16UC1 primitive index + 1 per pixel, 0 = none
 };
@@ -39,7 +39,7 @@ struct RenderParams {
   unsigned int seed = 7;
 };
 
-RenderedFrame renderPrimitives(const std::vector<ScenePrimitive>& scene,
+PrimitiveRendering renderPrimitives(const std::vector<ScenePrimitive>& scene,
                                const CameraIntrinsics& intrinsics, const RenderParams& params);
 
 }  // namespace quadric_slam

@@ -1,4 +1,4 @@
-#include "quadric_slam/frontend/segmentation_input.h"
+#include "quadric_slam/io/segmentation_input.h"
 
 #include <pcl/io/pcd_io.h>
 

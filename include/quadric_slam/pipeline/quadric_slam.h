@@ -1,0 +1,106 @@
+// The whole SLAM system for one depth camera, ROS-free: one frame in; normals, quadric
+// segmentation, odometry, mapping and reconstruction out (the paper's Section IV, Fig. 2).
+// The offline runner (scripts/run_bag) is a thin shell over this class; each nodelet wraps one of
+// the same stage classes with the same parameters (config/*.yaml, pipeline/pipeline_params.h).
+//
+// Per frame:
+//   1. time rule: a stamp not after the previous frame's (a looping bag, a restarted player)
+//      resets odometry, map and reconstruction before the frame is used (SlamFrameResult::reset);
+//   2. the depth image must fit its intrinsics, else the frame is skipped (processed = false);
+//   3. back-projection + normals (frontend/normal_estimator.h);
+//   4. quadric segmentation (frontend/quadric_segmenter.h), unless odometry only;
+//   5. odometry (odometry/odometry_tracker.h);
+//   6. mapping (mapping/quadric_mapper.h) once odometry is initialised, and on keyframes the
+//      supporting points of the landmark observations into the reconstruction.
+// Every stage is timed under its name (timer()): normals, segmentation, odometry, mapping,
+// reconstruction.
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <map>
+#include <string>
+
+#include "quadric_slam/eval/stage_timing.h"
+#include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/frontend/quadric_segmenter.h"
+#include "quadric_slam/io/frame_source.h"
+#include "quadric_slam/io/param_reader.h"
+#include "quadric_slam/mapping/quadric_mapper.h"
+#include "quadric_slam/mapping/reconstruction.h"
+#include "quadric_slam/odometry/odometry_tracker.h"
+#include "quadric_slam/types/observation.h"
+
+namespace quadric_slam {
+
+struct SlamParams {
+  BackProjectionParams back_projection;
+  NormalEstimator::Params normals;
+  QuadricSegmenter::Params segmentation;
+  OdometryTracker::Params odometry;
+  QuadricMapper::Params mapping;
+  QuadricReconstruction::Params reconstruction;
+  // false: normals and odometry only (no segmentation, no map).
+  bool mapping_enabled = true;
+
+  // Throws std::invalid_argument naming the bad field (of whichever stage) and its range.
+  void validate() const;
+};
+
+// Reads config_dir/{normal_estimation,segmentation,odometry,mapping}.yaml through the key tables
+// the nodelets use; absent files keep the defaults of their stage. The effective values go to
+// *log when given. Throws std::runtime_error (unreadable file) or std::invalid_argument (bad
+// value).
+SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log = nullptr);
+
+struct SlamFrameResult {
+  double stamp = 0.0;
+  bool reset = false;      // time went backwards: everything was reset before this frame
+  bool processed = false;  // false: skipped (message says why), nothing changed
+  std::string message;     // why the frame was skipped, or what a stage refused
+  OdometryTracker::Result odometry;
+  bool tracking = false;  // odometry is initialised (odometry.T_odom_camera is meaningful)
+  FrameMeasurements measurements;  // the segmentation's observations (camera frame)
+  bool mapped = false;             // the mapper accepted the frame (mapping is meaningful)
+  MapperFrameResult mapping;
+};
+
+class QuadricSlam {
+ public:
+  explicit QuadricSlam(const SlamParams& params);
+
+  SlamFrameResult process(const RgbdFrame& frame);
+
+  // Forgets odometry, map and reconstruction (landmark ids keep counting).
+  void reset();
+
+  const SlamParams& params() const { return params_; }
+  const QuadricMapper& mapper() const { return mapper_; }
+  const OdometryTracker& odometry() const { return odometry_; }
+  const QuadricReconstruction& reconstruction() const { return reconstruction_; }
+  // The landmarks' points on their current surfaces, label = landmark id.
+  pcl::PointCloud<pcl::PointXYZL> reconstructionCloud() const;
+  // The latest frame's organized cloud with normals, and its segmentation (labels per point).
+  const pcl::PointCloud<pcl::PointNormal>& cloud() const { return cloud_; }
+  const Segmentation& segmentation() const { return segmentation_; }
+  const StageTimer& timer() const { return timer_; }
+
+ private:
+  void addToReconstruction(const FrameMeasurements& measurements, const MapperFrameResult& mapped);
+
+  SlamParams params_;
+  NormalEstimator normals_;
+  QuadricSegmenter segmenter_;
+  OdometryTracker odometry_;
+  QuadricMapper mapper_;
+  QuadricReconstruction reconstruction_;
+  StageTimer timer_;
+  bool has_stamp_ = false;
+  double last_stamp_ = 0.0;
+  pcl::PointCloud<pcl::PointNormal> cloud_;  // storage reused from frame to frame
+  Segmentation segmentation_;
+};
+
+}  // namespace quadric_slam

@@ -1,0 +1,85 @@
+#include "quadric_slam/pipeline/pipeline_params.h"
+
+namespace quadric_slam {
+
+void readNormalEstimationParams(const ParamReader& reader, BackProjectionParams& back_projection,
+                                NormalEstimator::Params& normals, ParamLog& log) {
+  readParam(reader, "decimation", back_projection.decimation, log);
+  readParam(reader, "min_range", back_projection.min_range, log);
+  readParam(reader, "max_range", back_projection.max_range, log);
+  readParam(reader, "normal_method", normals.method, log);
+  readParam(reader, "max_depth_change_factor", normals.max_depth_change_factor, log);
+  readParam(reader, "normal_smoothing_size", normals.normal_smoothing_size, log);
+  readParam(reader, "depth_dependent_smoothing", normals.depth_dependent_smoothing, log);
+  readParam(reader, "threads", normals.threads, log);
+  readParam(reader, "normal_stride", normals.normal_stride, log);
+  back_projection.validate();
+  normals.validate();
+}
+
+void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& params, ParamLog& log) {
+  PointToPlaneIcp::Params& icp = params.icp;
+  readParam(reader, "pyramid_levels", icp.pyramid_levels, log);
+  readParam(reader, "finest_stride", icp.finest_stride, log);
+  readParam(reader, "reference_stride", icp.reference_stride, log);
+  readParam(reader, "max_iterations", icp.max_iterations, log);
+  readParam(reader, "max_correspondence_distance", icp.max_correspondence_distance, log);
+  readParam(reader, "coarse_distance_factor", icp.coarse_distance_factor, log);
+  readParam(reader, "max_normal_angle", icp.max_normal_angle, log);
+  readParam(reader, "depth_noise_weighting", icp.depth_noise_weighting, log);
+  readParam(reader, "huber_delta", icp.huber_delta, log);
+  readParam(reader, "convergence_translation", icp.convergence_translation, log);
+  readParam(reader, "convergence_rotation", icp.convergence_rotation, log);
+  readParam(reader, "min_correspondences", icp.min_correspondences, log);
+  readParam(reader, "min_eigenvalue_ratio", icp.min_eigenvalue_ratio, log);
+  readParam(reader, "degenerate_variance", icp.degenerate_variance, log);
+  readParam(reader, "max_translation_from_guess", icp.max_translation_from_guess, log);
+  readParam(reader, "max_rotation_from_guess", icp.max_rotation_from_guess, log);
+  readParam(reader, "keyframe_translation", params.keyframe_translation, log);
+  readParam(reader, "keyframe_rotation", params.keyframe_rotation, log);
+  readParam(reader, "keyframe_min_overlap", params.keyframe_min_overlap, log);
+  readParam(reader, "constant_velocity", params.constant_velocity, log);
+  readParam(reader, "lost_frames_before_new_keyframe", params.lost_frames_before_new_keyframe, log);
+  params.validate();
+}
+
+void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
+                       QuadricReconstruction::Params& reconstruction, ParamLog& log) {
+  QuadricMap::Params& map = mapper.map;
+  readParam(reader, "min_observations", map.min_observations, log);
+  readParam(reader, "candidate_timeout_frames", map.candidate_timeout_frames, log);
+  QuadricAssociator::Params& association = map.association;
+  readParam(reader, "gate_probability", association.gate_probability, log);
+  readParam(reader, "floor_translation_sigma", association.floor_translation_sigma, log);
+  readParam(reader, "floor_rotation_sigma", association.floor_rotation_sigma, log);
+  readParam(reader, "floor_scale_fraction", association.floor_scale_fraction, log);
+  readParam(reader, "pose_translation_sigma", association.pose_translation_sigma, log);
+  readParam(reader, "pose_rotation_sigma", association.pose_rotation_sigma, log);
+  readParam(reader, "check_extent", association.check_extent, log);
+  readParam(reader, "extent_margin", association.extent_margin, log);
+  readParam(reader, "association_max_range", association.max_range, log);
+  SlidingWindow::Params& window = mapper.window;
+  readParam(reader, "window_size", window.size, log);
+  readParam(reader, "max_iterations", window.max_iterations, log);
+  readParam(reader, "observation_huber", window.observation_huber, log);
+  readParam(reader, "oldest_pose_translation_sigma", window.oldest_pose_translation_sigma, log);
+  readParam(reader, "oldest_pose_rotation_sigma", window.oldest_pose_rotation_sigma, log);
+  readParam(reader, "landmark_prior_inflation", window.landmark_prior_inflation, log);
+  readParam(reader, "compute_covariance", window.compute_covariance, log);
+  readParam(reader, "keyframe_translation", mapper.keyframe_translation, log);
+  readParam(reader, "keyframe_rotation", mapper.keyframe_rotation, log);
+  readParam(reader, "odometry_translation_sigma", mapper.odometry_translation_sigma, log);
+  readParam(reader, "odometry_translation_fraction", mapper.odometry_translation_fraction, log);
+  readParam(reader, "odometry_rotation_sigma", mapper.odometry_rotation_sigma, log);
+  readParam(reader, "odometry_rotation_fraction", mapper.odometry_rotation_fraction, log);
+  readParam(reader, "odometry_rotation_per_metre", mapper.odometry_rotation_per_metre, log);
+  readParam(reader, "reconstruction_voxel_size", reconstruction.voxel_size, log);
+  readParam(reader, "reconstruction_max_points_per_landmark",
+            reconstruction.max_points_per_landmark, log);
+  readParam(reader, "reconstruction_max_surface_distance", reconstruction.max_surface_distance,
+            log);
+  mapper.validate();
+  reconstruction.validate();
+}
+
+}  // namespace quadric_slam
