@@ -1,6 +1,9 @@
 #include "quadric_slam/frontend/detection_measurement.h"
 
+#include <algorithm>
 #include <stdexcept>
+#include <unordered_map>
+#include <vector>
 
 namespace quadric_slam {
 
@@ -34,6 +37,46 @@ FrameMeasurements toFrameMeasurements(const Segmentation& segmentation, double s
   for (const QuadricDetection& d : segmentation.detections)
     frame.observations.push_back(toMeasurement(d));
   return frame;
+}
+
+void attachSupportPoints(FrameMeasurements& frame, const Segmentation& segmentation,
+                         const pcl::PointCloud<pcl::PointNormal>& cloud, int max_points) {
+  const cv::Mat& labels = segmentation.labels;
+  if (max_points <= 0 || frame.observations.empty() || labels.empty() ||
+      labels.cols != static_cast<int>(cloud.width) || labels.rows != static_cast<int>(cloud.height))
+    return;
+  // label -> observation; counts per label decide the stride.
+  std::unordered_map<int, std::size_t> observation_of_label;
+  for (std::size_t i = 0; i < frame.observations.size(); ++i)
+    if (frame.observations[i].label > 0)
+      observation_of_label[frame.observations[i].label] = i;
+  std::vector<int> count(frame.observations.size(), 0), seen(frame.observations.size(), 0);
+  for (int v = 0; v < labels.rows; ++v)
+    for (int u = 0; u < labels.cols; ++u) {
+      const int label = labels.at<std::uint16_t>(v, u);
+      const auto it = label > 0 ? observation_of_label.find(label) : observation_of_label.end();
+      if (it != observation_of_label.end())
+        ++count[it->second];
+    }
+  std::vector<int> stride(frame.observations.size(), 1);
+  for (std::size_t i = 0; i < frame.observations.size(); ++i) {
+    stride[i] = std::max(1, (count[i] + max_points - 1) / max_points);
+    frame.observations[i].support_points.clear();
+    frame.observations[i].support_points.reserve(std::min(count[i], max_points));
+  }
+  for (int v = 0; v < labels.rows; ++v)
+    for (int u = 0; u < labels.cols; ++u) {
+      const int label = labels.at<std::uint16_t>(v, u);
+      const auto it = label > 0 ? observation_of_label.find(label) : observation_of_label.end();
+      if (it == observation_of_label.end())
+        continue;
+      const std::size_t i = it->second;
+      QuadricMeasurement& m = frame.observations[i];
+      const Eigen::Vector3f p = cloud(u, v).getVector3fMap();
+      if (seen[i]++ % stride[i] == 0 && p.allFinite() &&
+          static_cast<int>(m.support_points.size()) < max_points)
+        m.support_points.push_back(p);
+    }
 }
 
 }  // namespace quadric_slam

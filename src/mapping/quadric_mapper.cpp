@@ -145,7 +145,11 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
   for (const QuadricMeasurement& measurement : frame.observations) {
     const std::string why = validateMeasurement(measurement);
     if (why.empty()) {
+      // The mapper keeps measurements in candidates and window keyframes; their supporting
+      // points are the reconstruction's business, not the estimator's, so they stay out.
       valid.push_back(measurement);
+      valid.back().support_points.clear();
+      valid.back().support_points.shrink_to_fit();
       continue;
     }
     ++result.rejected_measurements;

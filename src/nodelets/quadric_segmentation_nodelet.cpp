@@ -6,6 +6,7 @@
 // Parameters  config/segmentation.yaml (every key documented there)
 // Publishes   observations (quadric_slam/QuadricObservationArray, the cloud's stamp and frame; an
 //             empty array when the frame holds no quadric, e.g. an empty or all-NaN cloud)
+//             (each with at most ~max_support_points supporting points for the reconstruction)
 //             ~segmentation_image (sensor_msgs/Image rgb8, a colour per segment; only computed
 //             while subscribed)
 //             ~segmented_cloud (sensor_msgs/PointCloud2 x y z label, organized, label 0 =
@@ -73,6 +74,9 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
       const RosParamReader reader(private_nh);
       readSegmentationParams(reader, params, log);
       readParam(reader, "queue_size", queue_size, log);
+      readParam(reader, "max_support_points", max_support_points_, log);
+      if (max_support_points_ < 0)
+        throw std::invalid_argument("max_support_points must be >= 0");
       segmenter_ = std::make_unique<QuadricSegmenter>(params);
     } catch (const std::invalid_argument& e) {
       NODELET_FATAL("quadric_segmentation: invalid parameter: %s", e.what());
@@ -96,26 +100,37 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
       diagnostics_->frameDropped(problem);
       return;
     }
-    pcl::PointCloud<pcl::PointNormal> cloud;
-    pcl::fromROSMsg(*msg, cloud);
-    if (cloud.height <= 1 && !cloud.empty()) {
-      // A single point or a 1 x N row: organized enough for the segmenter's grid.
-      cloud.height = 1;
-      cloud.width = static_cast<std::uint32_t>(cloud.size());
+    // roscpp does not catch what a callback throws: the manager, and every nodelet in it, would
+    // die. Whatever the core throws drops this cloud with a reason instead.
+    try {
+      pcl::PointCloud<pcl::PointNormal> cloud;
+      pcl::fromROSMsg(*msg, cloud);
+      if (cloud.height <= 1 && !cloud.empty()) {
+        // A single point or a 1 x N row: organized enough for the segmenter's grid.
+        cloud.height = 1;
+        cloud.width = static_cast<std::uint32_t>(cloud.size());
+      }
+      const Segmentation segmentation = segmenter_->segment(cloud);
+
+      // Core measurements (detection_measurement.h) -> messages (ros/conversions.h); the header is
+      // the cloud's, copied exactly (the conversion goes through a double stamp).
+      FrameMeasurements measurements =
+          toFrameMeasurements(segmentation, msg->header.stamp.toSec(), msg->header.frame_id);
+      attachSupportPoints(measurements, segmentation, cloud, max_support_points_);
+      auto out = boost::make_shared<QuadricObservationArray>(toObservationArrayMsg(
+          measurements));
+      out->header = msg->header;
+      observations_pub_.publish(out);
+
+      if (image_pub_.getNumSubscribers() > 0)
+        publishImage(segmentation, msg->header);
+      if (cloud_pub_.getNumSubscribers() > 0)
+        publishCloud(cloud, segmentation, msg->header);
+    } catch (const std::exception& e) {
+      NODELET_ERROR_THROTTLE(5.0, "quadric_segmentation: dropping cloud: %s", e.what());
+      diagnostics_->frameDropped(e.what());
+      return;
     }
-    const Segmentation segmentation = segmenter_->segment(cloud);
-
-    // Core measurements (detection_measurement.h) -> messages (ros/conversions.h); the header is
-    // the cloud's, copied exactly (the conversion goes through a double stamp).
-    auto out = boost::make_shared<QuadricObservationArray>(toObservationArrayMsg(
-        toFrameMeasurements(segmentation, msg->header.stamp.toSec(), msg->header.frame_id)));
-    out->header = msg->header;
-    observations_pub_.publish(out);
-
-    if (image_pub_.getNumSubscribers() > 0)
-      publishImage(segmentation, msg->header);
-    if (cloud_pub_.getNumSubscribers() > 0)
-      publishCloud(cloud, segmentation, msg->header);
     diagnostics_->frameProcessed(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
             .count());
@@ -153,6 +168,7 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
   }
 
   std::unique_ptr<QuadricSegmenter> segmenter_;
+  int max_support_points_ = 1000;
   std::unique_ptr<NodeletDiagnostics> diagnostics_;
   ros::Subscriber cloud_sub_;
   ros::Publisher observations_pub_, image_pub_, cloud_pub_;

@@ -10,27 +10,6 @@
 
 namespace quadric_slam {
 
-namespace {
-
-// The points of each label 1..count of a segmentation's label image (index label - 1).
-std::vector<std::vector<Eigen::Vector3f>> pointsPerLabel(
-    const pcl::PointCloud<pcl::PointNormal>& cloud, const cv::Mat& labels, std::size_t count) {
-  std::vector<std::vector<Eigen::Vector3f>> points(count);
-  if (labels.empty() || labels.cols != static_cast<int>(cloud.width) ||
-      labels.rows != static_cast<int>(cloud.height))
-    return points;
-  for (int v = 0; v < labels.rows; ++v) {
-    for (int u = 0; u < labels.cols; ++u) {
-      const unsigned label = labels.at<std::uint16_t>(v, u);
-      if (label >= 1 && label <= count)
-        points[label - 1].push_back(cloud(u, v).getVector3fMap());
-    }
-  }
-  return points;
-}
-
-}  // namespace
-
 void SlamParams::validate() const {
   back_projection.validate();
   normals.validate();
@@ -38,6 +17,9 @@ void SlamParams::validate() const {
   odometry.validate();
   mapping.validate();
   reconstruction.validate();
+  if (max_support_points < 0)
+    throw std::invalid_argument("max_support_points must be >= 0, got " +
+                                std::to_string(max_support_points));
 }
 
 SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log) {
@@ -51,7 +33,9 @@ SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log) {
   };
   readNormalEstimationParams(reader("normal_estimation.yaml"), params.back_projection,
                              params.normals, effective);
-  readSegmentationParams(reader("segmentation.yaml"), params.segmentation, effective);
+  const YamlParamReader segmentation = reader("segmentation.yaml");
+  readSegmentationParams(segmentation, params.segmentation, effective);
+  readParam(segmentation, "max_support_points", params.max_support_points, effective);
   readOdometryParams(reader("odometry.yaml"), params.odometry, effective);
   readMappingParams(reader("mapping.yaml"), params.mapping, params.reconstruction, effective);
   params.validate();
@@ -105,6 +89,7 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
   if (params_.mapping_enabled) {
     segmentation_ = timer_.time("segmentation", [&] { return segmenter_.segment(cloud_); });
     out.measurements = toFrameMeasurements(segmentation_, frame.stamp, frame.frame_id);
+    attachSupportPoints(out.measurements, segmentation_, cloud_, params_.max_support_points);
   }
   out.odometry = timer_.time("odometry", [&] { return odometry_.track(cloud_, k, frame.stamp); });
   out.tracking = odometry_.initialized();
@@ -128,8 +113,6 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
 // The supporting points of the keyframe's landmark observations, on their landmarks' surfaces.
 void QuadricSlam::addToReconstruction(const FrameMeasurements& measurements,
                                       const MapperFrameResult& mapped) {
-  const auto points =
-      pointsPerLabel(cloud_, segmentation_.labels, segmentation_.detections.size());
   // update.measurements lists the accepted measurements in input order, the rejected left out.
   std::size_t input = 0;
   for (const MeasurementResult& fate : mapped.update.measurements) {
@@ -138,14 +121,13 @@ void QuadricSlam::addToReconstruction(const FrameMeasurements& measurements,
       ++input;
     if (input >= measurements.observations.size())
       break;
-    const int label = measurements.observations[input++].label;
-    if ((fate.fate != MeasurementFate::kLandmark && fate.fate != MeasurementFate::kPromoted) ||
-        label < 1 || label > static_cast<int>(points.size()))
+    const QuadricMeasurement& measurement = measurements.observations[input++];
+    if (fate.fate != MeasurementFate::kLandmark && fate.fate != MeasurementFate::kPromoted)
       continue;
     const auto landmark = mapper_.map().landmarks().find(fate.id);
     if (landmark != mapper_.map().landmarks().end())
       reconstruction_.addPoints(fate.id, landmark->second.quadric_map, mapped.T_map_camera,
-                                points[label - 1]);
+                                measurement.support_points);
   }
 }
 

@@ -116,6 +116,12 @@ QuadricObservation toObservationMsg(const QuadricMeasurement& measurement) {
   msg.image_roi.width = measurement.image_roi.width;
   msg.image_roi.height = measurement.image_roi.height;
   msg.fit_rms = static_cast<float>(measurement.fit_rms);
+  msg.support_points.resize(measurement.support_points.size());
+  for (std::size_t i = 0; i < measurement.support_points.size(); ++i) {
+    msg.support_points[i].x = measurement.support_points[i].x();
+    msg.support_points[i].y = measurement.support_points[i].y();
+    msg.support_points[i].z = measurement.support_points[i].z();
+  }
   return msg;
 }
 
@@ -136,6 +142,13 @@ QuadricMeasurement fromObservationMsg(const QuadricObservation& msg) {
   measurement.fit_rms = msg.fit_rms;
   measurement.extent_min = fromPointMsg(msg.surface.extent_min);
   measurement.extent_max = fromPointMsg(msg.surface.extent_max);
+  // Non-finite points are left out (the reconstruction would skip them anyway).
+  measurement.support_points.reserve(msg.support_points.size());
+  for (const geometry_msgs::Point32& p : msg.support_points) {
+    const Eigen::Vector3f point(p.x, p.y, p.z);
+    if (point.allFinite())
+      measurement.support_points.push_back(point);
+  }
   return measurement;
 }
 

@@ -42,6 +42,9 @@ struct SlamParams {
   OdometryTracker::Params odometry;
   QuadricMapper::Params mapping;
   QuadricReconstruction::Params reconstruction;
+  // Supporting points each observation carries to the mapper (segmentation.yaml
+  // max_support_points; frontend/detection_measurement.h), >= 0.
+  int max_support_points = 1000;
   // false: normals and odometry only (no segmentation, no map).
   bool mapping_enabled = true;
 

@@ -29,6 +29,9 @@ struct QuadricMeasurement {
   // Axis-aligned box of the supporting points in the quadric frame (m).
   Eigen::Vector3d extent_min = Eigen::Vector3d::Zero();
   Eigen::Vector3d extent_max = Eigen::Vector3d::Zero();
+  // A bounded subset of the supporting points (camera frame, m) for the reconstruction; may be
+  // empty (frontend/detection_measurement.h: attachSupportPoints).
+  std::vector<Eigen::Vector3f> support_points;
 };
 
 // All observations of one frame.
