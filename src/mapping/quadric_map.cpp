@@ -142,7 +142,8 @@ MapUpdate QuadricMap::integrate(int frame_index, double stamp,
   // 4. Promotion of candidates seen often enough (this frame's only: others were checked before).
   std::vector<QuadricCandidate> kept;
   for (QuadricCandidate& candidate : candidates_) {
-    if (candidate.last_frame == frame_index && candidate.observations >= params_.min_observations) {
+    if (promotion_ && candidate.last_frame == frame_index &&
+        candidate.observations >= params_.min_observations) {
       QuadricLandmark landmark;
       landmark.id = next_landmark_id_++;
       landmark.quadric_map = candidate.quadric_map;
@@ -180,6 +181,24 @@ void QuadricMap::setEstimate(int id, const QuadricModel& quadric_map,
                                                                     landmark.quadric_map.pose()));
   landmark.quadric_map = quadric_map;
   landmark.covariance = covariance;
+}
+
+void QuadricMap::insertLandmark(const QuadricLandmark& landmark) {
+  if (landmark.id < 1)
+    throw std::invalid_argument("QuadricMap::insertLandmark: id " + std::to_string(landmark.id) +
+                                " must be >= 1");
+  if (landmarks_.count(landmark.id) != 0)
+    throw std::invalid_argument("QuadricMap::insertLandmark: id " + std::to_string(landmark.id) +
+                                " is already in use");
+  const int k = minimalDimension(landmark.quadric_map.quadricClass());
+  if (landmark.covariance.size() != 0 &&
+      (landmark.covariance.rows() != k || landmark.covariance.cols() != k))
+    throw std::invalid_argument("QuadricMap::insertLandmark: landmark " +
+                                std::to_string(landmark.id) + ": covariance is not " +
+                                std::to_string(k) + "x" + std::to_string(k) + " for a " +
+                                toString(landmark.quadric_map.quadricClass()));
+  landmarks_.emplace(landmark.id, landmark);
+  next_landmark_id_ = std::max(next_landmark_id_, landmark.id + 1);
 }
 
 void QuadricMap::clear() {

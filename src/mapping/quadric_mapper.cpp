@@ -94,7 +94,7 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
   // The current best pose of the latest frame, reported for refused frames.
   auto latestEstimate = [&]() {
     if (window_.keyframes().empty())
-      return T_odom_previous_;
+      return Eigen::Isometry3d(T_map_odom_start_ * T_odom_previous_);
     const Keyframe& kf = window_.keyframes().back();
     return Eigen::Isometry3d(kf.T_map_camera * kf.T_odom_camera.inverse() * T_odom_previous_);
   };
@@ -159,7 +159,7 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
 
   // 1. Prediction from the latest keyframe and the odometry since.
   const bool first = window_.keyframes().empty();
-  Eigen::Isometry3d T_map_predicted = T_odom_camera;
+  Eigen::Isometry3d T_map_predicted = T_map_odom_start_ * T_odom_camera;
   Eigen::Isometry3d T_keyframe_this = Eigen::Isometry3d::Identity();
   if (!first) {
     const Keyframe& kf = window_.keyframes().back();
@@ -219,7 +219,54 @@ void QuadricMapper::reset() {
   has_frame_ = false;
   last_stamp_ = 0.0;
   T_odom_previous_ = Eigen::Isometry3d::Identity();
+  T_map_odom_start_ = Eigen::Isometry3d::Identity();
   covariance_since_keyframe_.setZero();
+}
+
+void QuadricMapper::loadLandmarks(const std::vector<QuadricLandmark>& landmarks, bool fixed,
+                                  const Eigen::Isometry3d& T_map_odom) {
+  if (!isRigid(T_map_odom))
+    throw std::invalid_argument("QuadricMapper::loadLandmarks: T_map_odom is not rigid");
+  // Validate on a scratch map first, so that a bad list leaves the mapper as it was.
+  QuadricMap scratch(params_.map);
+  for (const QuadricLandmark& landmark : landmarks)
+    scratch.insertLandmark(landmark);
+  reset();
+  for (const QuadricLandmark& landmark : landmarks) {
+    map_.insertLandmark(landmark);
+    if (fixed)
+      window_.setLandmarkFixed(landmark.id);
+  }
+  T_map_odom_start_ = T_map_odom;
+}
+
+void QuadricMapper::setLocalizationOnly(bool on) {
+  localization_only_ = on;
+  map_.setPromotion(!on);
+  window_.setAllLandmarksFixed(on);
+}
+
+int addKeyframeToReconstruction(const FrameMeasurements& frame, const MapperFrameResult& result,
+                                const QuadricMap& map, QuadricReconstruction* reconstruction) {
+  int stored = 0;
+  // result.update.measurements lists the accepted measurements in input order, the rejected left
+  // out: walk the input alongside, skipping what process() refused.
+  std::size_t input = 0;
+  for (const MeasurementResult& fate : result.update.measurements) {
+    while (input < frame.observations.size() &&
+           !QuadricMapper::validateMeasurement(frame.observations[input]).empty())
+      ++input;
+    if (input >= frame.observations.size())
+      break;
+    const QuadricMeasurement& measurement = frame.observations[input++];
+    if (fate.fate != MeasurementFate::kLandmark && fate.fate != MeasurementFate::kPromoted)
+      continue;
+    const auto landmark = map.landmarks().find(fate.id);
+    if (landmark != map.landmarks().end())
+      stored += reconstruction->addPoints(fate.id, landmark->second.quadric_map,
+                                          result.T_map_camera, measurement.support_points);
+  }
+  return stored;
 }
 
 std::vector<QuadricLandmark> QuadricMapper::landmarks() const {

@@ -45,8 +45,17 @@ void SlidingWindow::countObservation(int landmark_id) {
   ++observation_counts_[landmark_id];
 }
 
+void SlidingWindow::setLandmarkFixed(int landmark_id, bool fixed) {
+  if (fixed)
+    fixed_landmarks_.insert(landmark_id);
+  else
+    fixed_landmarks_.erase(landmark_id);
+}
+
 void SlidingWindow::foldIntoPrior(const Keyframe& keyframe, const WindowObservation& observation,
                                   const QuadricMap& map) {
+  if (landmarkFixed(observation.landmark_id))
+    return;  // a constant block needs no prior
   const QuadricModel& landmark = map.landmark(observation.landmark_id).quadric_map;
   const ObservationLinearization lin =
       linearizeObservation(observation.measurement.quadric_camera, keyframe.T_map_camera, landmark);
@@ -157,6 +166,8 @@ WindowStatistics SlidingWindow::optimize(QuadricMap* map) {
     if (!manifold)
       manifold = std::make_unique<QuadricManifold>(quadric.quadricClass());
     problem.AddParameterBlock(block.data(), kQuadricParameterSize, manifold.get());
+    if (landmarkFixed(id))
+      problem.SetParameterBlockConstant(block.data());
     return block.data();
   };
   for (int i = 0; i < n; ++i) {
@@ -172,7 +183,7 @@ WindowStatistics SlidingWindow::optimize(QuadricMap* map) {
   PoseBlock identity;
   poseToParameters(Eigen::Isometry3d::Identity(), identity.data());
   for (const auto& [id, prior] : priors_) {
-    if (landmarks.count(id) == 0)
+    if (landmarks.count(id) == 0 || landmarkFixed(id))
       continue;
     const Eigen::LLT<Eigen::MatrixXd> information(prior.information);
     if (information.info() != Eigen::Success)
@@ -216,21 +227,26 @@ WindowStatistics SlidingWindow::optimize(QuadricMap* map) {
   for (int i = 0; i < n; ++i)
     keyframes_[i].T_map_camera = poseFromParameters(poses[i].data());
 
+  // Fixed landmarks keep their estimates and covariances: only the free ones are written back.
+  std::vector<int> free_landmarks;
+  for (const auto& [id, block] : landmarks)
+    if (!landmarkFixed(id))
+      free_landmarks.push_back(id);
   std::map<int, Eigen::MatrixXd> covariances;
-  if (params_.compute_covariance && !landmarks.empty()) {
+  if (params_.compute_covariance && !free_landmarks.empty()) {
     ceres::Covariance::Options covariance_options;
     covariance_options.algorithm_type = ceres::SPARSE_QR;
     covariance_options.num_threads = 1;
     ceres::Covariance covariance(covariance_options);
     std::vector<std::pair<const double*, const double*>> blocks;
-    for (const auto& [id, block] : landmarks)
-      blocks.emplace_back(block.data(), block.data());
+    for (int id : free_landmarks)
+      blocks.emplace_back(landmarks.at(id).data(), landmarks.at(id).data());
     if (covariance.Compute(blocks, &problem)) {
-      for (const auto& [id, block] : landmarks) {
+      for (int id : free_landmarks) {
+        const double* block = landmarks.at(id).data();
         const int k = minimalDimension(map->landmark(id).quadric_map.quadricClass());
         RowMajor c(k, k);
-        if (!covariance.GetCovarianceBlockInTangentSpace(block.data(), block.data(), c.data()) ||
-            !c.allFinite())
+        if (!covariance.GetCovarianceBlockInTangentSpace(block, block, c.data()) || !c.allFinite())
           continue;
         const Eigen::MatrixXd symmetric = 0.5 * (c + c.transpose());
         if (Eigen::LLT<Eigen::MatrixXd>(symmetric).info() == Eigen::Success)
@@ -238,11 +254,11 @@ WindowStatistics SlidingWindow::optimize(QuadricMap* map) {
       }
     }
   }
-  for (const auto& [id, block] : landmarks) {
+  for (int id : free_landmarks) {
     const QuadricModel& old = map->landmark(id).quadric_map;
     try {
       const QuadricModel updated =
-          quadricFromParameters(block.data(), old.quadricClass(), old.signature());
+          quadricFromParameters(landmarks.at(id).data(), old.quadricClass(), old.signature());
       auto it = covariances.find(id);
       map->setEstimate(id, updated, it != covariances.end() ? it->second : Eigen::MatrixXd());
     } catch (const std::invalid_argument&) {
@@ -256,6 +272,7 @@ void SlidingWindow::clear() {
   keyframes_.clear();
   observation_counts_.clear();
   priors_.clear();
+  fixed_landmarks_.clear();
   first_keyframe_in_window_ = any_keyframe_ = false;
   last_ = WindowStatistics{};
 }

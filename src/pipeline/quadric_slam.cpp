@@ -113,22 +113,7 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
 // The supporting points of the keyframe's landmark observations, on their landmarks' surfaces.
 void QuadricSlam::addToReconstruction(const FrameMeasurements& measurements,
                                       const MapperFrameResult& mapped) {
-  // update.measurements lists the accepted measurements in input order, the rejected left out.
-  std::size_t input = 0;
-  for (const MeasurementResult& fate : mapped.update.measurements) {
-    while (input < measurements.observations.size() &&
-           !QuadricMapper::validateMeasurement(measurements.observations[input]).empty())
-      ++input;
-    if (input >= measurements.observations.size())
-      break;
-    const QuadricMeasurement& measurement = measurements.observations[input++];
-    if (fate.fate != MeasurementFate::kLandmark && fate.fate != MeasurementFate::kPromoted)
-      continue;
-    const auto landmark = mapper_.map().landmarks().find(fate.id);
-    if (landmark != mapper_.map().landmarks().end())
-      reconstruction_.addPoints(fate.id, landmark->second.quadric_map, mapped.T_map_camera,
-                                measurement.support_points);
-  }
+  addKeyframeToReconstruction(measurements, mapped, mapper_.map(), &reconstruction_);
 }
 
 pcl::PointCloud<pcl::PointXYZL> QuadricSlam::reconstructionCloud() const {

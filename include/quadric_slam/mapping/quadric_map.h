@@ -90,6 +90,15 @@ class QuadricMap {
   void setEstimate(int id, const QuadricModel& quadric_map, const Eigen::MatrixXd& covariance);
   const std::vector<QuadricCandidate>& candidates() const { return candidates_; }
 
+  // Adds a landmark known from elsewhere (a saved map) under its own id; landmarks promoted later
+  // get larger ids. Throws std::invalid_argument when the id is < 1 or already in use, or the
+  // covariance is neither empty nor k x k for the landmark's class.
+  void insertLandmark(const QuadricLandmark& landmark);
+  // false: candidates are still associated, counted and expired but never become landmarks
+  // (localisation against a fixed map). A mode, kept by clear(); default true.
+  void setPromotion(bool enabled) { promotion_ = enabled; }
+  bool promotion() const { return promotion_; }
+
   // Forgets landmarks and candidates; ids keep counting (never reused).
   void clear();
 
@@ -103,6 +112,7 @@ class QuadricMap {
   std::vector<QuadricCandidate> candidates_;
   int next_landmark_id_ = 1;
   int next_candidate_id_ = 1;
+  bool promotion_ = true;
 };
 
 }  // namespace quadric_slam

@@ -10,7 +10,12 @@
 //      or an old one seen again: a loop). Only keyframes carry factors; other frames' observations
 //      count towards promotion and observation counts only.
 //   4. On a keyframe, optimise the sliding window (mapping/window.h): bounded cost per frame.
-// The map frame is the first frame's odom pose (T_map_odom = identity until corrections).
+// The map frame is the first frame's odom pose (T_map_odom = identity until corrections), unless
+// a saved map was loaded (loadLandmarks below: T_map_odom is then given).
+//
+// Starting from a saved map: loadLandmarks() seeds the map with landmarks (ids kept), optionally
+// held fixed in the window; setLocalizationOnly(true) holds every landmark fixed and promotes no
+// candidate, so the map's estimates stay as loaded while the poses are estimated against them.
 //
 // Bad input has a defined behaviour and never reaches the map:
 //   - a stamp not finite or not after the previous accepted frame's: the frame is refused
@@ -30,6 +35,7 @@
 #include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/se3.h"
 #include "quadric_slam/mapping/quadric_map.h"
+#include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/mapping/window.h"
 
 namespace quadric_slam {
@@ -88,8 +94,30 @@ class QuadricMapper {
 
   MapperFrameResult process(const FrameMeasurements& frame, const OdometryInput& odometry);
 
-  // Forgets everything but the id counters (landmark ids are never reused).
+  // Forgets everything but the id counters (landmark ids are never reused) and the localisation
+  // mode.
   void reset();
+
+  // Starts from a saved map: forgets the current state (as reset()), then inserts `landmarks`
+  // with their ids, estimates, covariances (empty = unknown), extents (all-zero = unknown) and
+  // counts; landmarks promoted later get larger ids. fixed: the loaded landmarks are constant in
+  // the window (SlidingWindow::setLandmarkFixed): they correct the poses and are never changed.
+  // T_map_odom places the odometry in the loaded map: the next frame's prediction is
+  // T_map_odom T_odom_camera (identity: the odometry starts where the map's session started).
+  // There is no global relocalisation: that prediction must be within the association gate of
+  // the truth (about 10 cm / 3 deg with the default floors) for the landmarks to be recognised, and
+  // the first keyframe after loading is held fixed as usual (the window's gauge).
+  // Throws std::invalid_argument (id < 1 or repeated, covariance of the wrong size, T_map_odom not
+  // rigid) and then leaves the mapper unchanged.
+  void loadLandmarks(const std::vector<QuadricLandmark>& landmarks, bool fixed,
+                     const Eigen::Isometry3d& T_map_odom = Eigen::Isometry3d::Identity());
+
+  // Localisation only: every landmark is constant in the window and no candidate is promoted, so
+  // the landmarks' estimates never change (their observation counts, stamps and extents still do)
+  // while the poses are estimated against them. A mode: kept by reset() and loadLandmarks(); off
+  // by default.
+  void setLocalizationOnly(bool on);
+  bool localizationOnly() const { return localization_only_; }
 
   const QuadricMap& map() const { return map_; }
   const SlidingWindow& window() const { return window_; }
@@ -108,9 +136,20 @@ class QuadricMapper {
   SlidingWindow window_;
   int frame_index_ = 0;
   bool has_frame_ = false;
+  bool localization_only_ = false;
+  // Where the first frame after a reset or a load is placed: T_map_predicted = this T_odom_camera.
+  Eigen::Isometry3d T_map_odom_start_ = Eigen::Isometry3d::Identity();
   double last_stamp_ = 0.0;
   Eigen::Isometry3d T_odom_previous_ = Eigen::Isometry3d::Identity();
   Matrix6d covariance_since_keyframe_ = Matrix6d::Zero();  // body tangent of the latest frame
 };
+
+// The reconstruction's share of a keyframe, as QuadricSlam and the mapping nodelet compute it: the
+// supporting points of the frame's measurements that went to a landmark (fates kLandmark and
+// kPromoted), seen from result.T_map_camera, added at their landmarks' current estimates in `map`.
+// `frame` holds the measurements given to process() (result.update lists only the accepted ones,
+// in input order). Call it for keyframes. Returns the number of points stored.
+int addKeyframeToReconstruction(const FrameMeasurements& frame, const MapperFrameResult& result,
+                                const QuadricMap& map, QuadricReconstruction* reconstruction);
 
 }  // namespace quadric_slam

@@ -29,6 +29,7 @@
 #include <Eigen/Geometry>
 #include <deque>
 #include <map>
+#include <set>
 #include <vector>
 
 #include "quadric_slam/types/observation.h"
@@ -109,6 +110,18 @@ class SlidingWindow {
     return observation_counts_.count(landmark_id) > 0;
   }
   const WindowStatistics& lastStatistics() const { return last_; }
+
+  // Fixed landmarks (a trusted, loaded map) are constant blocks of the optimisation: their
+  // observations still correct the poses, but their estimates and covariances in the map are left
+  // as they are and no prior is folded for them. setLandmarkFixed marks one landmark (state,
+  // forgotten by clear()); setAllLandmarksFixed(true) holds every landmark (localisation only; a
+  // mode, kept by clear()).
+  void setLandmarkFixed(int landmark_id, bool fixed = true);
+  void setAllLandmarksFixed(bool fixed) { all_landmarks_fixed_ = fixed; }
+  bool landmarkFixed(int landmark_id) const {
+    return all_landmarks_fixed_ || fixed_landmarks_.count(landmark_id) > 0;
+  }
+
   void clear();
 
   const Params& params() const { return params_; }
@@ -130,6 +143,8 @@ class SlidingWindow {
   // Landmarks whose observations from keyframes that left the window were folded in (one entry
   // per landmark: grows with the map, not with the sequence).
   std::map<int, LandmarkPrior> priors_;
+  std::set<int> fixed_landmarks_;
+  bool all_landmarks_fixed_ = false;
   WindowStatistics last_;
 };
 

@@ -1,7 +1,8 @@
 // QuadricMapper on synthetic worlds with known truth (synthetic_world.h: measurement noise 5 mm /
 // 0.005 rad / 2% of scale; odometry with a 2% scale error and a 1 mrad-per-frame yaw bias):
 // the trajectory is much better than the drifting odometry and the landmarks converge; the window
-// problem stays bounded while the map grows; bad input is refused without touching the map.
+// problem stays bounded while the map grows; bad input is refused without touching the map; a
+// saved map is loaded (loadLandmarks) to localise against it unchanged or to extend it.
 #include <gtest/gtest.h>
 
 #include <iostream>
@@ -22,8 +23,11 @@ struct SyntheticRun {
   int max_measurements = 0;
 };
 
+// T_offset_odom: the odometry handed to the mapper is T_offset_odom * (drifting odometry), i.e.
+// expressed in another odom frame (out.odometry keeps the drifting odometry itself).
 SyntheticRun run(QuadricMapper* mapper, const std::vector<test::TrueLandmark>& world,
-                 const std::vector<Eigen::Isometry3d>& poses, int seed) {
+                 const std::vector<Eigen::Isometry3d>& poses, int seed,
+                 const Eigen::Isometry3d& T_offset_odom = Eigen::Isometry3d::Identity()) {
   std::mt19937 rng(seed);
   const std::vector<Eigen::Isometry3d> odometry = test::driftingOdometry(poses, rng);
   SyntheticRun out;
@@ -40,7 +44,7 @@ SyntheticRun run(QuadricMapper* mapper, const std::vector<test::TrueLandmark>& w
     out.max_measurements =
         std::max(out.max_measurements, static_cast<int>(frame.observations.size()));
     OdometryInput odom;
-    odom.T_odom_camera = odometry[i];
+    odom.T_odom_camera = T_offset_odom * odometry[i];
     const MapperFrameResult r = mapper->process(frame, odom);
     EXPECT_EQ(r.status, FrameStatus::kOk) << r.message;
     out.frames.push_back(r);
@@ -283,6 +287,145 @@ TEST(QuadricMapper, BadInputIsRefusedWithoutCorruptingTheMap) {
   run(&mapper, world, first, 305);
   ASSERT_FALSE(mapper.landmarks().empty());
   EXPECT_GT(mapper.landmarks().front().id, max_id);
+}
+
+// The mapper's map frame is the first odometry pose, which the synthetic odometry puts at the
+// first true pose: a pose in the map frame is truth[0]^-1 truth[i]. RMS translation error.
+double rmsErrorInMapFrame(const Trajectory& truth, const Trajectory& estimate) {
+  const Eigen::Isometry3d T_map_world = truth.front().T_world_sensor.inverse();
+  double sum = 0.0;
+  for (size_t i = 0; i < truth.size(); ++i)
+    sum += ((T_map_world * truth[i].T_world_sensor).translation() -
+            estimate[i].T_world_sensor.translation())
+               .squaredNorm();
+  return std::sqrt(sum / truth.size());
+}
+
+// A map saved from one run is loaded into a fresh mapper in localisation-only mode, whose odometry
+// lives in another odom frame (T_map_odom says where): the poses are estimated in the loaded map
+// frame, beat the odometry, and the landmarks stay exactly as loaded (no new ones).
+TEST(QuadricMapper, LocalisationOnlyAgainstALoadedMap) {
+  const std::vector<test::TrueLandmark> world = test::roomWorld();
+  const std::vector<Eigen::Isometry3d> poses = test::circleTrajectory(300, 1.0);
+  QuadricMapper mapping;
+  const SyntheticRun first = run(&mapping, world, poses, 401);
+  const std::vector<QuadricLandmark> saved = mapping.landmarks();
+  ASSERT_GE(saved.size(), world.size() - 2);
+
+  const Eigen::Isometry3d T_offset_odom =
+      makeIsometry(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+                   Eigen::Vector3d(1.0, -2.0, 0.3));
+  QuadricMapper localising;
+  localising.setLocalizationOnly(true);
+  localising.loadLandmarks(saved, /*fixed=*/true, T_offset_odom.inverse());
+  EXPECT_TRUE(localising.localizationOnly());
+  ASSERT_EQ(localising.landmarks().size(), saved.size());
+  const SyntheticRun second = run(&localising, world, poses, 402, T_offset_odom);
+
+  int measurements = 0, to_landmarks = 0;
+  for (const MapperFrameResult& f : second.frames) {
+    for (const MeasurementResult& m : f.update.measurements) {
+      ++measurements;
+      to_landmarks += m.fate == MeasurementFate::kLandmark;
+      EXPECT_NE(m.fate, MeasurementFate::kPromoted);
+    }
+  }
+  const double odometry_error = rmsErrorInMapFrame(second.truth, second.odometry);
+  const double first_error = rmsErrorInMapFrame(first.truth, first.mapper);
+  const double second_error = rmsErrorInMapFrame(second.truth, second.mapper);
+  std::cout << "loaded landmarks " << saved.size() << ", measurements to landmarks " << to_landmarks
+            << " of " << measurements << "\nRMS error in the map frame: odometry " << odometry_error
+            << " m, mapping run " << first_error << " m, localisation run " << second_error
+            << " m\n";
+  EXPECT_GT(to_landmarks, 0.9 * measurements);
+  EXPECT_LT(second_error, 0.3 * odometry_error);
+  EXPECT_LT(second_error, 0.05);
+
+  // The map is as loaded: same ids, estimates and covariances; only the counts grew.
+  const std::vector<QuadricLandmark> after = localising.landmarks();
+  ASSERT_EQ(after.size(), saved.size());
+  for (size_t i = 0; i < after.size(); ++i) {
+    EXPECT_EQ(after[i].id, saved[i].id);
+    EXPECT_TRUE(after[i].quadric_map.matrix() == saved[i].quadric_map.matrix()) << saved[i].id;
+    EXPECT_TRUE(after[i].covariance == saved[i].covariance) << saved[i].id;
+    EXPECT_GT(after[i].observations, saved[i].observations) << saved[i].id;
+  }
+  // A reset keeps the mode (a looping input localises again after reloading).
+  localising.reset();
+  EXPECT_TRUE(localising.localizationOnly());
+  EXPECT_TRUE(localising.landmarks().empty());
+}
+
+// In mapping mode a loaded map is extended: the loaded ids stay, new landmarks get larger ids;
+// loaded landmarks are refined unless loaded fixed.
+TEST(QuadricMapper, LoadedMapIsExtended) {
+  const std::vector<test::TrueLandmark> world = test::roomWorld();
+  const std::vector<Eigen::Isometry3d> poses = test::circleTrajectory(300, 1.0);
+  QuadricMapper partial;
+  run(&partial, world, std::vector<Eigen::Isometry3d>(poses.begin(), poses.begin() + 100), 501);
+  const std::vector<QuadricLandmark> saved = partial.landmarks();
+  ASSERT_GE(saved.size(), 3u);
+  int max_saved_id = 0;
+  for (const QuadricLandmark& l : saved)
+    max_saved_id = std::max(max_saved_id, l.id);
+
+  for (const bool fixed : {false, true}) {
+    QuadricMapper mapper;
+    mapper.loadLandmarks(saved, fixed);
+    run(&mapper, world, poses, 502);
+    const std::vector<QuadricLandmark> after = mapper.landmarks();
+    EXPECT_GT(after.size(), saved.size()) << "fixed " << fixed;
+    int changed = 0;
+    for (const QuadricLandmark& l : saved) {
+      const QuadricLandmark& now = mapper.map().landmark(l.id);  // still there
+      changed += !(now.quadric_map.matrix() == l.quadric_map.matrix());
+      EXPECT_GT(now.observations, l.observations);
+    }
+    EXPECT_EQ(changed, fixed ? 0 : static_cast<int>(saved.size()));
+    for (const QuadricLandmark& l : after) {
+      bool loaded = false;
+      for (const QuadricLandmark& s : saved)
+        loaded = loaded || s.id == l.id;
+      if (!loaded)
+        EXPECT_GT(l.id, max_saved_id);
+    }
+    std::cout << "fixed " << fixed << ": loaded " << saved.size() << ", now " << after.size()
+              << " landmarks, " << changed << " loaded ones refined\n";
+  }
+}
+
+TEST(QuadricMapper, LoadLandmarksRefusesBadInputAndKeepsTheMap) {
+  const std::vector<test::TrueLandmark> world = test::roomWorld();
+  const std::vector<Eigen::Isometry3d> poses = test::circleTrajectory(300, 0.2);
+  QuadricMapper mapper;
+  run(&mapper, world, poses, 601);
+  const std::vector<QuadricLandmark> before = mapper.landmarks();
+  ASSERT_GE(before.size(), 2u);
+  const size_t keyframes = mapper.window().keyframes().size();
+  auto expectUnchanged = [&](const char* what) {
+    ASSERT_EQ(mapper.landmarks().size(), before.size()) << what;
+    EXPECT_EQ(mapper.window().keyframes().size(), keyframes) << what;
+  };
+  std::vector<QuadricLandmark> bad = before;
+  bad[1].id = bad[0].id;
+  EXPECT_THROW(mapper.loadLandmarks(bad, false), std::invalid_argument);
+  expectUnchanged("repeated id");
+  bad = before;
+  bad[0].id = 0;
+  EXPECT_THROW(mapper.loadLandmarks(bad, false), std::invalid_argument);
+  expectUnchanged("id 0");
+  bad = before;
+  bad[0].covariance = Eigen::MatrixXd::Identity(2, 2);
+  EXPECT_THROW(mapper.loadLandmarks(bad, false), std::invalid_argument);
+  expectUnchanged("covariance size");
+  Eigen::Isometry3d not_rigid = Eigen::Isometry3d::Identity();
+  not_rigid.linear() *= 2.0;
+  EXPECT_THROW(mapper.loadLandmarks(before, false, not_rigid), std::invalid_argument);
+  expectUnchanged("T_map_odom");
+  // An empty list is a valid (empty) map.
+  mapper.loadLandmarks({}, true);
+  EXPECT_TRUE(mapper.landmarks().empty());
+  EXPECT_TRUE(mapper.window().keyframes().empty());
 }
 
 }  // namespace
