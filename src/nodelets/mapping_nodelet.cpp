@@ -1,0 +1,671 @@
+// mapping: quadric observations + odometry -> the quadric map (the paper's back-end), with the core
+// QuadricMapper and QuadricReconstruction, computing per frame what QuadricSlam computes offline.
+//
+// Subscribes  observations (quadric_slam/QuadricObservationArray, camera optical frame; from
+//             quadric_slam/QuadricSegmentation) and odom (nav_msgs/Odometry, pose of the camera in
+//             ~odom_frame; from quadric_slam/Odometry), paired by exact stamp (message_filters)
+// Publishes   map (quadric_slam/QuadricMap in ~map_frame, latched: on keyframes, after a load or
+//             a reset)
+//             markers (visualization_msgs/MarkerArray, latched, with the map)
+//             reconstruction (sensor_msgs/PointCloud2 x y z rgb label in ~map_frame, latched: every
+//             ~reconstruction_every_keyframes keyframes, on ~save_map and after ~load_map)
+//             path (nav_msgs/Path of T_map_camera per frame in ~map_frame, at most ~max_path_poses)
+//             tf ~map_frame -> ~odom_frame (T_map_odom, REP-105; when ~publish_tf)
+//             /diagnostics (landmarks per class, window, solve time, associations, frames
+//             processed and dropped, every ~diagnostic_period)
+// Services    ~save_map (quadric_slam/SaveMap): map YAML + reconstruction PCD beside it
+//             ~load_map (quadric_slam/LoadMap): start from a saved map, optionally localisation
+//             only
+// All parameters are documented in config/mapping.yaml.
+//
+// Bad input has a defined behaviour: time going backwards (a looping bag) resets the map (to the
+// loaded map, if one was loaded) with a warning; a frame with a non-finite or non-unit pose, a
+// non-finite or negative covariance, an odom frame other than ~odom_frame or a repeated stamp is
+// dropped; an observation that does not convert (bad class, pose, scale, covariance size) or that
+// the mapper refuses is dropped, the rest of the frame is used. Each gets a throttled error naming
+// the problem and is counted on /diagnostics. No callback lets an exception escape (it would take
+// the whole manager down).
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <message_filters/subscriber.h>
+#include <message_filters/sync_policies/exact_time.h>
+#include <message_filters/synchronizer.h>
+#include <nav_msgs/Odometry.h>
+#include <nav_msgs/Path.h>
+#include <nodelet/nodelet.h>
+#include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <pluginlib/class_list_macros.hpp>
+#include <string>
+#include <vector>
+
+#include "quadric_slam/LoadMap.h"
+#include "quadric_slam/QuadricObservationArray.h"
+#include "quadric_slam/SaveMap.h"
+#include "quadric_slam/mapping/quadric_mapper.h"
+#include "quadric_slam/mapping/reconstruction.h"
+#include "quadric_slam/pipeline/pipeline_params.h"
+#include "quadric_slam/ros/conversions.h"
+#include "quadric_slam/ros/map_files.h"
+#include "quadric_slam/ros/map_publisher.h"
+#include "quadric_slam/ros/params.h"
+#include "quadric_slam/ros/reconstruction_cloud.h"
+
+namespace quadric_slam {
+
+namespace {
+
+std::string withoutLeadingSlash(const std::string& frame) {
+  return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
+}
+
+// Empty when the odometry message is usable, else the problem.
+std::string odometryProblem(const nav_msgs::Odometry& odom, const std::string& odom_frame) {
+  if (withoutLeadingSlash(odom.header.frame_id) != withoutLeadingSlash(odom_frame))
+    return "odom is in frame '" + odom.header.frame_id + "', not ~odom_frame '" + odom_frame + "'";
+  const auto& p = odom.pose.pose.position;
+  const auto& q = odom.pose.pose.orientation;
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+    return "odom position is not finite";
+  if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z) || !std::isfinite(q.w))
+    return "odom orientation is not finite";
+  const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+  if (std::abs(norm - 1.0) > 1e-3)
+    return "odom orientation is not a unit quaternion (norm " + std::to_string(norm) +
+           "): not a rotation";
+  for (int i = 0; i < 36; ++i) {
+    if (!std::isfinite(odom.pose.covariance[i]))
+      return "odom pose covariance is not finite";
+  }
+  for (int i = 0; i < 6; ++i) {
+    if (odom.pose.covariance[7 * i] < 0.0)
+      return "odom pose covariance has a negative variance (entry " + std::to_string(7 * i) + ")";
+  }
+  return "";
+}
+
+geometry_msgs::Transform toTransformMsg(const Eigen::Isometry3d& T) {
+  const geometry_msgs::Pose pose = toPoseMsg(T);
+  geometry_msgs::Transform transform;
+  transform.translation.x = pose.position.x;
+  transform.translation.y = pose.position.y;
+  transform.translation.z = pose.position.z;
+  transform.rotation = pose.orientation;
+  return transform;
+}
+
+}  // namespace
+
+class MappingNodelet : public nodelet::Nodelet {
+ public:
+  ~MappingNodelet() override {
+    // The synchroniser calls back into this object: disconnect it before the members go.
+    sync_.reset();
+  }
+
+ private:
+  using SyncPolicy =
+      message_filters::sync_policies::ExactTime<QuadricObservationArray, nav_msgs::Odometry>;
+
+  void onInit() override {
+    ros::NodeHandle& nh = getNodeHandle();
+    ros::NodeHandle& private_nh = getPrivateNodeHandle();
+
+    ParamLog log;
+    QuadricMapper::Params mapper_params;
+    QuadricReconstruction::Params reconstruction_params;
+    int queue_size = 10;
+    double diagnostic_period = 1.0;
+    bool localization_only = false;
+    try {
+      const RosParamReader reader(private_nh);
+      readParam(reader, "map_frame", map_frame_, log);
+      readParam(reader, "odom_frame", odom_frame_, log);
+      readParam(reader, "publish_tf", publish_tf_, log);
+      readParam(reader, "queue_size", queue_size, log);
+      readParam(reader, "reconstruction_every_keyframes", reconstruction_every_keyframes_, log);
+      readParam(reader, "max_path_poses", max_path_poses_, log);
+      readParam(reader, "map_file", map_file_, log);
+      readParam(reader, "localization_only", localization_only, log);
+      readParam(reader, "diagnostic_period", diagnostic_period, log);
+      readMappingParams(reader, mapper_params, reconstruction_params, log);
+      if (map_frame_.empty() || odom_frame_.empty() ||
+          withoutLeadingSlash(map_frame_) == withoutLeadingSlash(odom_frame_))
+        throw std::invalid_argument("map_frame and odom_frame must be non-empty and differ");
+      if (queue_size < 1)
+        throw std::invalid_argument("queue_size must be >= 1");
+      if (reconstruction_every_keyframes_ < 1)
+        throw std::invalid_argument("reconstruction_every_keyframes must be >= 1");
+      if (max_path_poses_ < 1)
+        throw std::invalid_argument("max_path_poses must be >= 1");
+      if (!(diagnostic_period > 0.0))
+        throw std::invalid_argument("diagnostic_period must be > 0 s");
+      mapper_ = std::make_unique<QuadricMapper>(mapper_params);
+      reconstruction_ = std::make_unique<QuadricReconstruction>(reconstruction_params);
+      mapper_->setLocalizationOnly(localization_only);
+    } catch (const std::invalid_argument& e) {
+      NODELET_FATAL("mapping: invalid parameter: %s", e.what());
+      throw;
+    }
+    NODELET_INFO("mapping parameters:%s", log.str().c_str());
+
+    // A map to start from: loaded when the file exists; otherwise ~save_map will write it.
+    if (!map_file_.empty()) {
+      std::string message;
+      if (std::filesystem::exists(map_file_)) {
+        if (!loadMap(map_file_, localization_only, &message)) {
+          NODELET_FATAL("mapping: cannot load ~map_file: %s", message.c_str());
+          throw std::runtime_error(message);
+        }
+        NODELET_INFO("mapping: %s", message.c_str());
+      } else if (localization_only) {
+        NODELET_FATAL("mapping: ~localization_only needs a map, but ~map_file %s does not exist",
+                      map_file_.c_str());
+        throw std::runtime_error("~map_file " + map_file_ + " does not exist");
+      } else {
+        NODELET_WARN(
+            "mapping: ~map_file %s does not exist yet: starting with an empty map "
+            "(~save_map will write it)",
+            map_file_.c_str());
+      }
+    } else if (localization_only) {
+      NODELET_WARN(
+          "mapping: ~localization_only without ~map_file: localising against an empty "
+          "map until ~load_map is called");
+    }
+
+    tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
+    // (The message QuadricMap shares its name with the core class: see ros/map_publisher.h.)
+    map_publisher_ = QuadricMapPublisher(nh, "map", "markers");
+    reconstruction_pub_ = nh.advertise<sensor_msgs::PointCloud2>("reconstruction", 1, true);
+    path_pub_ = nh.advertise<nav_msgs::Path>("path", queue_size);
+    save_service_ = private_nh.advertiseService("save_map", &MappingNodelet::onSaveMap, this);
+    load_service_ = private_nh.advertiseService("load_map", &MappingNodelet::onLoadMap, this);
+
+    diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh, private_nh, getName());
+    diagnostics_->setHardwareID("quadric_slam");
+    diagnostics_->add("mapping", this, &MappingNodelet::diagnose);
+    diagnostics_timer_ = nh.createWallTimer(ros::WallDuration(diagnostic_period),
+                                            &MappingNodelet::onDiagnosticsTimer, this);
+
+    // Latched outputs from the start (the empty or loaded map).
+    publishMap(ros::Time::now());
+    publishReconstruction(ros::Time::now());
+
+    observations_sub_.subscribe(nh, "observations", queue_size);
+    odom_sub_.subscribe(nh, "odom", queue_size);
+    observations_sub_.registerCallback(&MappingNodelet::onObservationsArrived, this);
+    odom_sub_.registerCallback(&MappingNodelet::onOdomArrived, this);
+    sync_ = std::make_unique<message_filters::Synchronizer<SyncPolicy>>(
+        SyncPolicy(static_cast<std::uint32_t>(queue_size)), observations_sub_, odom_sub_);
+    sync_->registerCallback(&MappingNodelet::onFrame, this);
+  }
+
+  // --- Input ------------------------------------------------------------------------------------
+
+  void onObservationsArrived(const QuadricObservationArrayConstPtr&) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stats_.observation_messages;
+  }
+  void onOdomArrived(const nav_msgs::OdometryConstPtr&) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stats_.odom_messages;
+  }
+
+  void onFrame(const QuadricObservationArrayConstPtr& observations,
+               const nav_msgs::OdometryConstPtr& odom) {
+    // roscpp does not catch what a callback throws: the manager, and every nodelet in it, would
+    // die. Whatever goes wrong drops this frame with a reason instead.
+    try {
+      std::lock_guard<std::mutex> lock(mutex_);
+      processFrame(*observations, *odom);
+    } catch (const std::exception& e) {
+      dropFrame(std::string("unexpected error: ") + e.what());
+    }
+  }
+
+  void dropFrame(const std::string& reason) {
+    NODELET_ERROR_THROTTLE(5.0, "mapping: dropping frame: %s", reason.c_str());
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stats_.frames_dropped;
+    stats_.last_drop_reason = reason;
+  }
+
+  void processFrame(const QuadricObservationArray& observations, const nav_msgs::Odometry& odom) {
+    const auto start = std::chrono::steady_clock::now();
+    {
+      std::lock_guard<std::mutex> lock(stats_mutex_);
+      ++stats_.synchronised;
+    }
+    const ros::Time stamp = observations.header.stamp;
+    // 1. Time rule.
+    if (have_stamp_ && stamp < last_stamp_) {
+      NODELET_WARN(
+          "mapping: time went backwards (%.3f s after %.3f s; a looping bag?): resetting "
+          "the map%s",
+          stamp.toSec(), last_stamp_.toSec(), base_map_ ? " to the loaded map" : "");
+      reset();
+      std::lock_guard<std::mutex> lock(stats_mutex_);
+      ++stats_.resets;
+    } else if (have_stamp_ && stamp == last_stamp_) {
+      dropFrame("repeated stamp " + std::to_string(stamp.toSec()) + " s");
+      return;
+    }
+
+    // 2. Odometry.
+    const std::string problem = odometryProblem(odom, odom_frame_);
+    if (!problem.empty()) {
+      dropFrame(problem);
+      return;
+    }
+    OdometryInput odometry;
+    odometry.T_odom_camera = fromPoseMsg(odom.pose.pose);
+    // The odometry's covariance is cumulative since its start: like QuadricSlam, the mapper uses
+    // its own noise model for the increments (config/mapping.yaml odometry_*).
+
+    // 3. Observations: those that do not convert are dropped, the rest of the frame is used.
+    FrameMeasurements frame;
+    frame.stamp = stamp.toSec();
+    frame.frame_id = observations.header.frame_id;
+    frame.observations.reserve(observations.observations.size());
+    int bad = 0;
+    std::string why;
+    for (const QuadricObservation& observation : observations.observations) {
+      try {
+        frame.observations.push_back(fromObservationMsg(observation));
+      } catch (const std::invalid_argument& e) {
+        ++bad;
+        why = e.what();
+      }
+    }
+    if (bad > 0) {
+      NODELET_ERROR_THROTTLE(5.0, "mapping: dropped %d of %zu observations at %.3f s: %s", bad,
+                             observations.observations.size(), stamp.toSec(), why.c_str());
+    }
+
+    // 4. The mapper.
+    const MapperFrameResult result = mapper_->process(frame, odometry);
+    if (result.status != FrameStatus::kOk) {
+      dropFrame("mapper refused the frame: " + result.message);
+      return;
+    }
+    have_stamp_ = true;
+    last_stamp_ = stamp;
+    T_map_odom_ = result.T_map_odom;
+    if (result.rejected_measurements > 0) {
+      NODELET_ERROR_THROTTLE(5.0, "mapping: mapper dropped %d observations at %.3f s: %s",
+                             result.rejected_measurements, stamp.toSec(), result.message.c_str());
+    }
+
+    // 5. The reconstruction grows on keyframes.
+    if (result.keyframe) {
+      addKeyframeToReconstruction(frame, result, mapper_->map(), reconstruction_.get());
+      ++keyframes_;
+    }
+
+    // 6. Outputs.
+    appendPath(stamp, result.T_map_camera);
+    if (publish_tf_) {
+      geometry_msgs::TransformStamped tf;
+      tf.header.stamp = stamp;
+      tf.header.frame_id = map_frame_;
+      tf.child_frame_id = odom_frame_;
+      tf.transform = toTransformMsg(result.T_map_odom);
+      tf_broadcaster_->sendTransform(tf);
+    }
+    if (result.keyframe) {
+      publishMap(stamp);
+      if (keyframes_ % reconstruction_every_keyframes_ == 0)
+        publishReconstruction(stamp);
+    }
+
+    countLandmarks();
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++stats_.frames_processed;
+    stats_.keyframes += result.keyframe;
+    stats_.observations += static_cast<long>(observations.observations.size());
+    stats_.observations_dropped += bad + result.rejected_measurements;
+    if (bad + result.rejected_measurements > 0)
+      stats_.last_observation_problem = bad > 0 ? why : result.message;
+    stats_.last = FrameStats{};
+    for (const MeasurementResult& m : result.update.measurements) {
+      switch (m.fate) {
+        case MeasurementFate::kLandmark:
+          ++stats_.last.to_landmarks;
+          break;
+        case MeasurementFate::kCandidate:
+          ++stats_.last.to_candidates;
+          break;
+        case MeasurementFate::kNewCandidate:
+          ++stats_.last.new_candidates;
+          break;
+        case MeasurementFate::kPromoted:
+          ++stats_.last.promoted;
+          break;
+      }
+    }
+    stats_.total_to_landmarks += stats_.last.to_landmarks;
+    stats_.total_promoted += stats_.last.promoted;
+    stats_.association_ms = 1e3 * result.association_seconds;
+    if (result.keyframe) {
+      stats_.window = result.window;
+      stats_.solve_ms = 1e3 * result.optimisation_seconds;
+    }
+    stats_.processing_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  // Forgets the map (back to the loaded one, if any), the reconstruction and the path.
+  void reset() {
+    mapper_->reset();
+    reconstruction_->clear();
+    path_.clear();
+    keyframes_ = 0;
+    have_stamp_ = false;
+    T_map_odom_ = Eigen::Isometry3d::Identity();
+    if (base_map_)
+      seed(*base_map_, Eigen::Isometry3d::Identity());
+    publishMap(ros::Time::now());
+    publishReconstruction(ros::Time::now());
+    countLandmarks();
+  }
+
+  // --- Saved maps
+  // ---------------------------------------------------------------------------------
+
+  struct BaseMap {
+    LoadedMap map;
+    bool fixed = false;
+  };
+
+  // The mapper and the reconstruction from a loaded map, the odometry placed with T_map_odom.
+  void seed(const BaseMap& base, const Eigen::Isometry3d& T_map_odom) {
+    mapper_->loadLandmarks(base.map.landmarks, base.fixed, T_map_odom);
+    reconstruction_->clear();
+    std::map<int, std::vector<Eigen::Vector3f>> points;
+    for (const pcl::PointXYZL& p : base.map.reconstruction)
+      points[static_cast<int>(p.label)].emplace_back(p.x, p.y, p.z);
+    for (const auto& [id, landmark_points] : points)
+      reconstruction_->addPoints(id, mapper_->map().landmark(id).quadric_map,
+                                 Eigen::Isometry3d::Identity(), landmark_points);
+  }
+
+  // Replaces the map with the saved one at `path`; false (mapper untouched) with *message saying
+  // why, or true with *message saying what was loaded.
+  bool loadMap(const std::string& path, bool localization_only, std::string* message) {
+    auto base = std::make_unique<BaseMap>();
+    try {
+      base->map = loadMapFiles(path);
+      base->fixed = localization_only;
+      // The odometry keeps its place in the map (identity before the first frame or after a
+      // reset).
+      seed(*base, T_map_odom_);
+    } catch (const std::exception& e) {
+      *message = e.what();
+      return false;
+    }
+    mapper_->setLocalizationOnly(localization_only);
+    const std::size_t points = base->map.reconstruction.size();
+    *message = "loaded " + std::to_string(base->map.landmarks.size()) + " quadrics from " + path +
+               (base->map.reconstruction_path.empty()
+                    ? std::string(" (no reconstruction beside it)")
+                    : " and " + std::to_string(points) + " reconstruction points from " +
+                          base->map.reconstruction_path) +
+               (localization_only ? "; localisation only" : "; mapping on");
+    if (withoutLeadingSlash(base->map.frame_id) != withoutLeadingSlash(map_frame_))
+      *message += "; the file's frame '" + base->map.frame_id + "' is taken as ~map_frame '" +
+                  map_frame_ + "'";
+    base_map_ = std::move(base);
+    loaded_from_ = path;
+    path_.clear();
+    keyframes_ = 0;
+    countLandmarks();
+    return true;
+  }
+
+  bool onSaveMap(SaveMap::Request& request, SaveMap::Response& response) {
+    try {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const std::string path = request.path.empty() ? map_file_ : request.path;
+      if (path.empty()) {
+        response.success = false;
+        response.message = "no path given and ~map_file is empty";
+        return true;
+      }
+      const std::vector<QuadricLandmark> landmarks = mapper_->landmarks();
+      const sensor_msgs::PointCloud2Ptr cloud = reconstructionCloud(ros::Time::now());
+      saveMapFiles(path, landmarks, map_frame_, *cloud);
+      // The latched outputs show what was saved (the map's counts move on between keyframes).
+      publishMap(cloud->header.stamp);
+      reconstruction_pub_.publish(cloud);
+      response.success = true;
+      response.num_quadrics = static_cast<std::uint32_t>(landmarks.size());
+      response.message = "wrote " + std::to_string(landmarks.size()) + " quadrics to " + path;
+      if (cloud->width > 0)
+        response.message += " and " + std::to_string(cloud->width) + " reconstruction points to " +
+                            reconstructionPathFor(path);
+      NODELET_INFO("mapping: %s", response.message.c_str());
+    } catch (const std::exception& e) {
+      response.success = false;
+      response.message = e.what();
+      NODELET_ERROR("mapping: ~save_map failed: %s", e.what());
+    }
+    return true;
+  }
+
+  bool onLoadMap(LoadMap::Request& request, LoadMap::Response& response) {
+    try {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const std::string path = request.path.empty() ? map_file_ : request.path;
+      if (path.empty()) {
+        response.success = false;
+        response.message = "no path given and ~map_file is empty";
+        return true;
+      }
+      response.success = loadMap(path, request.localization_only, &response.message);
+      if (response.success) {
+        response.num_quadrics = static_cast<std::uint32_t>(mapper_->map().landmarks().size());
+        publishMap(ros::Time::now());
+        publishReconstruction(ros::Time::now());
+        NODELET_INFO("mapping: %s", response.message.c_str());
+      } else {
+        NODELET_ERROR("mapping: ~load_map failed, the map is unchanged: %s",
+                      response.message.c_str());
+      }
+    } catch (const std::exception& e) {
+      response.success = false;
+      response.message = e.what();
+      NODELET_ERROR("mapping: ~load_map failed: %s", e.what());
+    }
+    return true;
+  }
+
+  // --- Outputs ----------------------------------------------------------------------------------
+
+  void publishMap(const ros::Time& stamp) {
+    std_msgs::Header header;
+    header.stamp = stamp;
+    header.frame_id = map_frame_;
+    map_publisher_.publish(mapper_->landmarks(), header);
+  }
+
+  sensor_msgs::PointCloud2Ptr reconstructionCloud(const ros::Time& stamp) const {
+    std::map<int, QuadricModel> surfaces;
+    for (const auto& [id, landmark] : mapper_->map().landmarks())
+      surfaces[id] = landmark.quadric_map;
+    std_msgs::Header header;
+    header.stamp = stamp;
+    header.frame_id = map_frame_;
+    return boost::make_shared<sensor_msgs::PointCloud2>(
+        reconstructionCloudMsg(reconstruction_->cloud(surfaces), header));
+  }
+
+  void publishReconstruction(const ros::Time& stamp) {
+    reconstruction_pub_.publish(reconstructionCloud(stamp));
+  }
+
+  void appendPath(const ros::Time& stamp, const Eigen::Isometry3d& T_map_camera) {
+    geometry_msgs::PoseStamped pose;
+    pose.header.stamp = stamp;
+    pose.header.frame_id = map_frame_;
+    pose.pose = toPoseMsg(T_map_camera);
+    path_.push_back(pose);
+    while (static_cast<int>(path_.size()) > max_path_poses_)
+      path_.pop_front();
+    if (path_pub_.getNumSubscribers() == 0)
+      return;
+    auto path = boost::make_shared<nav_msgs::Path>();
+    path->header.stamp = stamp;
+    path->header.frame_id = map_frame_;
+    path->poses.assign(path_.begin(), path_.end());
+    path_pub_.publish(path);
+  }
+
+  // --- Diagnostics
+  // --------------------------------------------------------------------------------
+
+  struct FrameStats {
+    int to_landmarks = 0, to_candidates = 0, new_candidates = 0, promoted = 0;
+  };
+  struct Stats {
+    long observation_messages = 0, odom_messages = 0, synchronised = 0;
+    long frames_processed = 0, frames_dropped = 0, keyframes = 0, resets = 0;
+    long observations = 0, observations_dropped = 0, total_to_landmarks = 0, total_promoted = 0;
+    std::string last_drop_reason, last_observation_problem;
+    FrameStats last;
+    WindowStatistics window;
+    double solve_ms = 0.0, association_ms = 0.0, processing_ms = 0.0;
+    std::map<std::string, int> landmarks_per_class;
+    int landmarks = 0, candidates = 0;
+    std::string mode = "mapping";  // or "localisation only"
+    std::string loaded_from;       // the loaded map file, if any
+    // At the previous report.
+    long reported_processed = 0, reported_dropped = 0, reported_observations_dropped = 0;
+  };
+
+  // Landmark counts and mode for the diagnostics (called with mutex_ held).
+  void countLandmarks() {
+    std::map<std::string, int> per_class;
+    for (QuadricClass c : kAllQuadricClasses)
+      per_class[toString(c)] = 0;
+    for (const auto& [id, landmark] : mapper_->map().landmarks())
+      ++per_class[toString(landmark.quadric_map.quadricClass())];
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    stats_.landmarks_per_class = per_class;
+    stats_.landmarks = static_cast<int>(mapper_->map().landmarks().size());
+    stats_.candidates = static_cast<int>(mapper_->map().candidates().size());
+    stats_.mode = mapper_->localizationOnly() ? "localisation only" : "mapping";
+    stats_.loaded_from = loaded_from_;
+  }
+
+  void onDiagnosticsTimer(const ros::WallTimerEvent&) {
+    try {
+      diagnostics_->force_update();
+    } catch (const std::exception& e) {
+      NODELET_ERROR_THROTTLE(30.0, "mapping: diagnostics failed: %s", e.what());
+    }
+  }
+
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    Stats& s = stats_;
+    const long processed = s.frames_processed - s.reported_processed;
+    const long dropped = s.frames_dropped - s.reported_dropped;
+    const long observations_dropped = s.observations_dropped - s.reported_observations_dropped;
+    s.reported_processed = s.frames_processed;
+    s.reported_dropped = s.frames_dropped;
+    s.reported_observations_dropped = s.observations_dropped;
+    using diagnostic_msgs::DiagnosticStatus;
+    if (dropped > 0 && processed == 0)
+      status.summary(DiagnosticStatus::ERROR, "dropping every frame: " + s.last_drop_reason);
+    else if (dropped > 0)
+      status.summary(DiagnosticStatus::WARN, "dropping some frames: " + s.last_drop_reason);
+    else if (observations_dropped > 0)
+      status.summary(DiagnosticStatus::WARN,
+                     "dropping observations: " + s.last_observation_problem);
+    else if (processed == 0)
+      status.summary(DiagnosticStatus::OK, "waiting for input");
+    else
+      status.summary(DiagnosticStatus::OK, s.mode);
+
+    status.add("mode", s.mode);
+    status.add("loaded map", s.loaded_from.empty() ? std::string("none") : s.loaded_from);
+    status.add("landmarks", s.landmarks);
+    for (const auto& [name, count] : s.landmarks_per_class)
+      status.add("landmarks: " + name, count);
+    status.add("candidates", s.candidates);
+    status.add("frames processed", s.frames_processed);
+    status.add("frames dropped", s.frames_dropped);
+    status.add("last drop reason", s.last_drop_reason);
+    status.add("keyframes", s.keyframes);
+    status.add("resets (time went backwards)", s.resets);
+    status.add("observations received", s.observations);
+    status.add("observations dropped", s.observations_dropped);
+    status.add("last observation problem", s.last_observation_problem);
+    status.add("observation messages", s.observation_messages);
+    status.add("odom messages", s.odom_messages);
+    status.add("synchronised pairs", s.synchronised);
+    status.add("last frame: to landmarks", s.last.to_landmarks);
+    status.add("last frame: to candidates", s.last.to_candidates);
+    status.add("last frame: new candidates", s.last.new_candidates);
+    status.add("last frame: promoted", s.last.promoted);
+    status.add("associations to landmarks (total)", s.total_to_landmarks);
+    status.add("landmarks promoted (total)", s.total_promoted);
+    status.add("window keyframes", s.window.keyframes);
+    status.add("window landmarks", s.window.landmark_blocks);
+    status.add("window residual blocks", s.window.residual_blocks);
+    status.add("window iterations", s.window.iterations);
+    status.add("window final cost", s.window.final_cost);
+    status.add("solve time (ms, last keyframe)", s.solve_ms);
+    status.add("association time (ms, last frame)", s.association_ms);
+    status.add("processing time (ms, last frame)", s.processing_ms);
+  }
+
+  // Parameters.
+  std::string map_frame_ = "map";
+  std::string odom_frame_ = "odom";
+  bool publish_tf_ = true;
+  int reconstruction_every_keyframes_ = 5;
+  int max_path_poses_ = 10000;
+  std::string map_file_;
+
+  // State (mutex_): the core objects and what the outputs need.
+  std::mutex mutex_;
+  std::unique_ptr<QuadricMapper> mapper_;
+  std::unique_ptr<QuadricReconstruction> reconstruction_;
+  std::unique_ptr<BaseMap> base_map_;  // the loaded map a reset returns to
+  std::string loaded_from_;
+  bool have_stamp_ = false;
+  ros::Time last_stamp_;
+  Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
+  long keyframes_ = 0;  // since the last reset or load
+  std::deque<geometry_msgs::PoseStamped> path_;
+
+  // Diagnostics (stats_mutex_).
+  std::mutex stats_mutex_;
+  Stats stats_;
+
+  QuadricMapPublisher map_publisher_;
+  ros::Publisher reconstruction_pub_, path_pub_;
+  ros::ServiceServer save_service_, load_service_;
+  ros::WallTimer diagnostics_timer_;
+  std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
+  std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
+  message_filters::Subscriber<QuadricObservationArray> observations_sub_;
+  message_filters::Subscriber<nav_msgs::Odometry> odom_sub_;
+  std::unique_ptr<message_filters::Synchronizer<SyncPolicy>> sync_;
+};
+
+}  // namespace quadric_slam
+
+PLUGINLIB_EXPORT_CLASS(quadric_slam::MappingNodelet, nodelet::Nodelet)
