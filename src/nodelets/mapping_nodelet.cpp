@@ -213,13 +213,16 @@ class MappingNodelet : public nodelet::Nodelet {
 
   // --- Input ------------------------------------------------------------------------------------
 
-  void onObservationsArrived(const QuadricObservationArrayConstPtr&) {
-    std::lock_guard<std::mutex> lock(stats_mutex_);
-    ++stats_.observation_messages;
-  }
-  void onOdomArrived(const nav_msgs::OdometryConstPtr&) {
-    std::lock_guard<std::mutex> lock(stats_mutex_);
-    ++stats_.odom_messages;
+  // Arrivals are counted (against synchronised pairs) to show unmatched inputs on /diagnostics.
+  void onObservationsArrived(const QuadricObservationArrayConstPtr&) { countArrival(true); }
+  void onOdomArrived(const nav_msgs::OdometryConstPtr&) { countArrival(false); }
+  void countArrival(bool observations) {
+    try {
+      std::lock_guard<std::mutex> lock(stats_mutex_);
+      ++(observations ? stats_.observation_messages : stats_.odom_messages);
+    } catch (const std::exception& e) {
+      NODELET_ERROR_THROTTLE(30.0, "mapping: %s", e.what());
+    }
   }
 
   void onFrame(const QuadricObservationArrayConstPtr& observations,

@@ -386,8 +386,9 @@ TEST(QuadricMapper, LoadedMapIsExtended) {
       bool loaded = false;
       for (const QuadricLandmark& s : saved)
         loaded = loaded || s.id == l.id;
-      if (!loaded)
+      if (!loaded) {
         EXPECT_GT(l.id, max_saved_id);
+      }
     }
     std::cout << "fixed " << fixed << ": loaded " << saved.size() << ", now " << after.size()
               << " landmarks, " << changed << " loaded ones refined\n";
