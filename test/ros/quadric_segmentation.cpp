@@ -42,7 +42,7 @@ pcl::PointCloud<pcl::PointNormal> sceneCloud() {
   scene[3].shape =
       qs::PrimitiveShape::cylinder(Eigen::Vector3d(0.3, 0.8, 1.8), Eigen::Vector3d(0, -1, 0), 0.09);
   scene[3].axis_max = 0.55;
-  const qs::RenderedFrame frame = qs::renderPrimitives(scene, kinect(), qs::RenderParams());
+  const qs::PrimitiveRendering frame = qs::renderPrimitives(scene, kinect(), qs::RenderParams());
   const qs::DepthImageView<float> view = qs::depthViewOf(frame.depth);
   return qs::NormalEstimator(qs::NormalEstimator::Params())
       .compute(qs::backProject(view, kinect(), qs::BackProjectionParams()));
