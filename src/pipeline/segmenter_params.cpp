@@ -147,7 +147,8 @@ QuadricSegmenter::Params loadSegmenterParams(const std::string& yaml_path) {
   Params params;
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
-    if (key == "queue_size")  // the nodelet's own key
+    // The nodelet's own keys (max_support_points: also QuadricSlam's), not the segmenter's.
+    if (key == "queue_size" || key == "max_support_points")
       continue;
     const Entry& e = find(key);
     try {
