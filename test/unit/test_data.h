@@ -7,6 +7,7 @@
 //   QS_SKIP_WITHOUT_SHARED_DATA.
 #pragma once
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -18,15 +19,21 @@ inline std::filesystem::path shippedData(const std::string& relative) {
   return std::filesystem::path(QUADRIC_SLAM_TEST_DATA_DIR) / relative;
 }
 
-// ../shared/data/<relative>: may be absent (a clone without ../shared).
+// ../shared/data/<relative>: may be absent (a clone without ../shared). The environment variable
+// QUADRIC_SLAM_SHARED_DATA_DIR, when set, replaces ../shared/data: e.g. a missing folder shows
+// without a rebuild which tests a clone without ../shared runs and which it skips.
 inline std::filesystem::path sharedData(const std::string& relative) {
-  return std::filesystem::path(QUADRIC_SLAM_SHARED_DATA_DIR) / relative;
+  const char* from_environment = std::getenv("QUADRIC_SLAM_SHARED_DATA_DIR");
+  const std::filesystem::path root = from_environment && *from_environment
+                                         ? from_environment
+                                         : QUADRIC_SLAM_SHARED_DATA_DIR;
+  return root / relative;
 }
 
 // Why a piece of ../shared/data is not in test/data, for the skip message.
 inline constexpr char kResearchUseOnly[] = "research-use licence";
 inline constexpr char kFullGroundTruth[] =
-    "full TUM ground-truth files, too large (test/data holds an excerpt only)";
+    "full TUM ground-truth files, too large: test/data holds an excerpt only";
 
 inline std::string notShippedMessage(const std::filesystem::path& path, const char* reason) {
   return path.string() + " not found: this data is not shipped with the package (" + reason +
