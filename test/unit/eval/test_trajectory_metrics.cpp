@@ -7,6 +7,7 @@
 #include <string>
 
 #include "quadric_slam/eval/trajectory_metrics.h"
+#include "../test_data.h"
 
 using quadric_slam::AbsoluteTrajectoryError;
 using quadric_slam::RelativePoseError;
@@ -125,16 +126,14 @@ TEST(TrajectoryMetrics, RpeOfAConstantVelocityDriftIsThatVelocity) {
 }
 
 TEST(TrajectoryMetrics, ReproducesTumEvaluateAteOnRealTrajectories) {
-  const std::string dir = std::string(QUADRIC_SLAM_SHARED_DATA_DIR) + "/tum_groundtruth/";
-  if (!std::ifstream(dir + "rgbd_dataset_freiburg1_xyz-groundtruth.txt")) {
-    GTEST_SKIP() << "TUM ground truth not found in " << dir;
-  }
+  const std::string dir = quadric_slam::test::sharedData("tum_groundtruth/").string();
+  QS_SKIP_WITHOUT_SHARED_DATA(dir, quadric_slam::test::kFullGroundTruth);
   struct Reference {
     const char* sequence;
     std::size_t pairs;
     double rmse;
   };
-  // /work/shared/data/README.md: TUM evaluate_ate.py (groundtruth, rgbdslam), default options.
+  // ../shared/data/README.md: TUM evaluate_ate.py (groundtruth, rgbdslam), default options.
   const Reference references[] = {{"freiburg1_xyz", 786, 0.013473},
                                   {"freiburg1_desk", 574, 0.025831},
                                   {"freiburg2_desk", 2201, 0.095053},
@@ -157,10 +156,8 @@ TEST(TrajectoryMetrics, ReproducesTumEvaluateAteOnRealTrajectories) {
 }
 
 TEST(TrajectoryMetrics, RpeMatchesAPlainTranscriptionOfEvaluateRpe) {
-  const std::string dir = std::string(QUADRIC_SLAM_SHARED_DATA_DIR) + "/tum_groundtruth/";
-  if (!std::ifstream(dir + "rgbd_dataset_freiburg1_xyz-groundtruth.txt")) {
-    GTEST_SKIP() << "TUM ground truth not found in " << dir;
-  }
+  const std::string dir = quadric_slam::test::sharedData("tum_groundtruth/").string();
+  QS_SKIP_WITHOUT_SHARED_DATA(dir, quadric_slam::test::kFullGroundTruth);
   // Values from a line-by-line pure-Python transcription of TUM's evaluate_rpe.py with
   // --fixed_delta --delta 1 --delta_unit s (pairs, translational_error.rmse printed with %f).
   struct Reference {

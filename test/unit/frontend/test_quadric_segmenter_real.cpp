@@ -1,9 +1,10 @@
-// QuadricSegmenter on real Kinect frames (../shared/data; skipped when absent):
-// - OSD table-top scenes (mosd_cylinders, learn33..44): the table is a plane in every scene, and
+// QuadricSegmenter on real Kinect frames:
+// - OSD table-top scenes (../shared/data/mosd_cylinders, learn33..44; research-use, not shipped:
+//   skipped when absent): the table is a plane in every scene, and
 //   at least 80% of the upright cylindrical objects are cylinders whose labels overlap the
 //   object's labelled pixels with IoU >= 0.5.
-// - TUM fr3_long_office_household, depth 1341847980.723020: the globe is a sphere, the desk top
-//   and the floor are planes.
+// - TUM fr3_long_office_household, depth 1341847980.723020 (test/data): the globe is a sphere,
+//   the desk top and the floor are planes.
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
 
@@ -19,13 +20,13 @@
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/io/segmentation_input.h"
+#include "../real_frames.h"
+#include "../test_data.h"
 
 namespace qs = quadric_slam;
 using qs::QuadricClass;
 
 namespace {
-
-const std::string kData = QUADRIC_SLAM_SHARED_DATA_DIR;
 
 qs::Segmentation segmentCloud(const pcl::PointCloud<pcl::PointXYZ>& cloud) {
   const auto with_normals = qs::NormalEstimator(qs::NormalEstimator::Params()).compute(cloud);
@@ -74,9 +75,8 @@ const std::map<std::string, std::set<int>> kUprightCylinders = {{"learn33", {50,
 }  // namespace
 
 TEST(QuadricSegmenterReal, OsdTablesArePlanesAndUprightCylindersAreCylinders) {
-  const std::string dir = kData + "/mosd_cylinders";
-  if (!std::filesystem::exists(dir))
-    GTEST_SKIP() << "real data not found at " << dir;
+  const std::string dir = qs::test::sharedData("mosd_cylinders").string();
+  QS_SKIP_WITHOUT_SHARED_DATA(dir, qs::test::kResearchUseOnly);
   int cylinders = 0, found = 0;
   for (const auto& [scene, objects] : kUprightCylinders) {
     pcl::PointCloud<pcl::PointXYZRGBL> labelled;
@@ -160,9 +160,7 @@ Eigen::Vector2d project(const Eigen::Vector3d& p) {
 }  // namespace
 
 TEST(QuadricSegmenterReal, Fr3GlobeIsASphereDeskTopAndFloorArePlanes) {
-  const std::string file = kData + "/tum_frames/fr3_long_office_household/1341847980.723020.png";
-  if (!std::filesystem::exists(file))
-    GTEST_SKIP() << "real data not found at " << file;
+  const std::string file = qs::test::shippedData(qs::test::kFr3HouseholdDepth).string();
   qs::CameraIntrinsics k;
   k.fx = 535.4;
   k.fy = 539.2;

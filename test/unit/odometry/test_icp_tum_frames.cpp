@@ -1,5 +1,5 @@
 // Point-to-plane ICP on real Kinect frames of the TUM RGB-D benchmark (fr1_xyz), checked against
-// the benchmark's motion-capture ground truth. Skips when ../shared/data is absent.
+// the benchmark's motion-capture ground truth (frames and a ground-truth excerpt in test/data).
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -12,11 +12,10 @@
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/odometry/point_to_plane_icp.h"
+#include "../test_data.h"
 
 namespace quadric_slam {
 namespace {
-
-const std::string kData = QUADRIC_SLAM_SHARED_DATA_DIR;
 
 // Ground-truth pose (T_world_camera, colour optical frame) at time t, interpolated linearly in
 // position and by slerp in orientation between the two bracketing motion-capture samples.
@@ -75,8 +74,9 @@ pcl::PointCloud<pcl::PointNormal>::Ptr loadDepth(const std::string& path,
 // depth/mocap clock offset move the reference by several tenths of a degree. (The benchmark's
 // RGB-D SLAM trajectory gives 1.61 degrees for this pair, ICP 1.56, the interpolated truth 2.05.)
 TEST(IcpOnTumFrames, Fr1XyzMatchesMotionCapture) {
-  const std::string dir = kData + "/tum_frames/fr1_xyz/";
-  const std::string gt = kData + "/tum_groundtruth/rgbd_dataset_freiburg1_xyz-groundtruth.txt";
+  const std::string dir = test::shippedData("tum_frames/fr1_xyz/").string();
+  const std::string gt =
+      test::shippedData("tum_groundtruth/rgbd_dataset_freiburg1_xyz-groundtruth.txt").string();
   const double t_a = 1305031102.160407, t_b = 1305031102.262886;
   CameraIntrinsics k;  // Freiburg1 depth intrinsics (README of the data)
   k.fx = 517.3;
@@ -87,10 +87,10 @@ TEST(IcpOnTumFrames, Fr1XyzMatchesMotionCapture) {
   k.height = 480;
   auto a = loadDepth(dir + "1305031102.160407.png", k);
   auto b = loadDepth(dir + "1305031102.262886.png", k);
+  ASSERT_TRUE(a && b) << "TUM fr1_xyz depth frames not readable in " << dir;
   Eigen::Isometry3d T_world_a, T_world_b;
-  if (!a || !b || !groundTruthAt(gt, t_a, &T_world_a) || !groundTruthAt(gt, t_b, &T_world_b)) {
-    GTEST_SKIP() << "TUM fr1_xyz frames or ground truth not found under " << kData;
-  }
+  ASSERT_TRUE(groundTruthAt(gt, t_a, &T_world_a) && groundTruthAt(gt, t_b, &T_world_b))
+      << "no ground truth around the frames' stamps in " << gt;
   const Eigen::Isometry3d T_a_b = T_world_a.inverse() * T_world_b;
   ASSERT_GT(T_a_b.translation().norm(), 0.02);  // the frames really are apart
 

@@ -143,7 +143,7 @@ TEST(KinectDepthModel, ValidateNamesTheBadField) {
   EXPECT_THROW(p.validate(), std::invalid_argument);
 }
 
-// The real fr3_long_office frame (shared/data/README.md) has robust plane-fit residual std of
+// The real fr3_long_office frame (test/data/README.md) has robust plane-fit residual std of
 // 0.9 cm on the floor at about 2.1 m and 1.4 cm on the back wall at about 2.5 m. A rendered
 // fronto-parallel plane with the default model must give residuals of that size.
 TEST(KinectDepthModel, PlaneResidualsAreTheSizeOfTheRealFr3Frame) {

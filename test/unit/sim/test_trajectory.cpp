@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "quadric_slam/sim/trajectory.h"
+#include "../test_data.h"
 
 using namespace quadric_slam;
 
@@ -20,8 +21,8 @@ StampedPose pose(double stamp, const Eigen::Vector3d& t, double angle) {
   return p;
 }
 
-const std::string kFr1Desk = std::string(QUADRIC_SLAM_SHARED_DATA_DIR) +
-                             "/tum_groundtruth/rgbd_dataset_freiburg1_desk-groundtruth.txt";
+const std::string kFr1Desk =
+    test::sharedData("tum_groundtruth/rgbd_dataset_freiburg1_desk-groundtruth.txt").string();
 
 }  // namespace
 
@@ -50,8 +51,7 @@ TEST(Trajectory, ResamplesAt30HzFromTheFirstStamp) {
 }
 
 TEST(Trajectory, ReadsTheRealFr1DeskGroundTruth) {
-  if (!std::filesystem::exists(kFr1Desk))
-    GTEST_SKIP() << "real data absent: " << kFr1Desk;
+  QS_SKIP_WITHOUT_SHARED_DATA(kFr1Desk, test::kFullGroundTruth);
   const std::vector<StampedPose> t = readDrivingTrajectory(kFr1Desk);
   ASSERT_EQ(t.size(), 2335u);
   EXPECT_NEAR(t.front().stamp, 1305031449.7996, 1e-4);
@@ -65,10 +65,9 @@ TEST(Trajectory, ReadsTheRealFr1DeskGroundTruth) {
 }
 
 TEST(Trajectory, SkipsRepeatedStampsOfTheRealFr2DeskFile) {
-  const std::string path = std::string(QUADRIC_SLAM_SHARED_DATA_DIR) +
-                           "/tum_groundtruth/rgbd_dataset_freiburg2_desk-groundtruth.txt";
-  if (!std::filesystem::exists(path))
-    GTEST_SKIP() << "real data absent: " << path;
+  const std::string path =
+      test::sharedData("tum_groundtruth/rgbd_dataset_freiburg2_desk-groundtruth.txt").string();
+  QS_SKIP_WITHOUT_SHARED_DATA(path, test::kFullGroundTruth);
   const std::vector<StampedPose> t = readDrivingTrajectory(path);
   EXPECT_GT(t.size(), 20000u);
   for (std::size_t k = 1; k < t.size(); ++k)
