@@ -5,6 +5,10 @@
 //             quadric_slam/NormalEstimation)
 //             depth/camera_info (sensor_msgs/CameraInfo, the latest one is used; the cloud may be
 //             a decimation of that image: the factor is cloud width vs camera_info width)
+//             observations (quadric_slam/QuadricObservationArray from quadric_slam/
+//             QuadricSegmentation, only when ~use_observations: paired with points_normals by
+//             exact stamp, they give the tracker its motion guess for large steps, as in the
+//             offline runner)
 // Publishes   odom (nav_msgs/Odometry: pose of ~camera_frame in ~odom_frame with covariance)
 //             tf ~odom_frame -> ~camera_frame (when ~publish_tf)
 //             /diagnostics (diagnostic_msgs/DiagnosticArray, at most once a second)
@@ -17,6 +21,8 @@
 #include <nodelet/nodelet.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <message_filters/subscriber.h>
+#include <message_filters/time_synchronizer.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -30,8 +36,10 @@
 #include <sstream>
 #include <string>
 
-#include "quadric_slam/odometry/odometry_tracker.h"
+#include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
+#include "quadric_slam/odometry/odometry_tracker.h"
+#include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/params.h"
@@ -55,6 +63,7 @@ class OdometryNodelet : public nodelet::Nodelet {
       readParam(reader, "publish_tf", publish_tf_, log);
       readOdometryParams(reader, params, log);
       readParam(reader, "queue_size", queue_size, log);
+      readParam(reader, "use_observations", use_observations_, log);
       if (odom_frame_.empty() || camera_frame_.empty() || odom_frame_ == camera_frame_)
         throw std::invalid_argument("odom_frame and camera_frame must be non-empty and differ");
       if (queue_size < 1)
@@ -70,7 +79,30 @@ class OdometryNodelet : public nodelet::Nodelet {
     odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", queue_size);
     diagnostics_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
     info_sub_ = nh.subscribe("depth/camera_info", queue_size, &OdometryNodelet::onCameraInfo, this);
-    cloud_sub_ = nh.subscribe("points_normals", queue_size, &OdometryNodelet::onCloud, this);
+    if (use_observations_) {
+      cloud_filter_.subscribe(nh, "points_normals", queue_size);
+      observations_filter_.subscribe(nh, "observations", queue_size);
+      sync_ = std::make_unique<Synchronizer>(cloud_filter_, observations_filter_, queue_size);
+      sync_->registerCallback(&OdometryNodelet::onCloudAndObservations, this);
+    } else {
+      cloud_sub_ = nh.subscribe("points_normals", queue_size, &OdometryNodelet::onCloud, this);
+    }
+  }
+
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) { track(msg, nullptr); }
+
+  void onCloudAndObservations(const sensor_msgs::PointCloud2ConstPtr& msg,
+                              const QuadricObservationArrayConstPtr& observations) {
+    int rejected = 0;
+    const FrameMeasurements frame = fromObservationArrayMsg(*observations, &rejected);
+    if (rejected > 0) {
+      NODELET_WARN_THROTTLE(5.0,
+                            "odometry: %d of %zu observations at %.3f s did not convert; the "
+                            "motion guess uses the rest",
+                            rejected, observations->observations.size(),
+                            observations->header.stamp.toSec());
+    }
+    track(msg, &frame.observations);
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
@@ -85,7 +117,8 @@ class OdometryNodelet : public nodelet::Nodelet {
     have_intrinsics_ = true;
   }
 
-  void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+  void track(const sensor_msgs::PointCloud2ConstPtr& msg,
+             const std::vector<QuadricMeasurement>* observations) {
     CameraIntrinsics intrinsics;
     {
       std::lock_guard<std::mutex> lock(intrinsics_mutex_);
@@ -106,8 +139,7 @@ class OdometryNodelet : public nodelet::Nodelet {
     }
     problem = pointsNormalsFromMsg(*msg, cloud_);
     if (!problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud from %s: %s",
-                             cloud_sub_.getTopic().c_str(), problem.c_str());
+      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping points_normals cloud: %s", problem.c_str());
       return;
     }
 
@@ -125,7 +157,7 @@ class OdometryNodelet : public nodelet::Nodelet {
 
     OdometryTracker::Result result;
     try {
-      result = tracker_->track(cloud_, intrinsics, stamp);
+      result = tracker_->track(cloud_, intrinsics, stamp, observations);
     } catch (const std::invalid_argument& e) {
       NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", e.what());
       return;
@@ -254,7 +286,13 @@ class OdometryNodelet : public nodelet::Nodelet {
   long frames_ = 0;
   long counts_[3] = {0, 0, 0};
   ros::WallTime last_diagnostics_;
+  bool use_observations_ = false;
   ros::Subscriber cloud_sub_, info_sub_;
+  using Synchronizer =
+      message_filters::TimeSynchronizer<sensor_msgs::PointCloud2, QuadricObservationArray>;
+  message_filters::Subscriber<sensor_msgs::PointCloud2> cloud_filter_;
+  message_filters::Subscriber<QuadricObservationArray> observations_filter_;
+  std::unique_ptr<Synchronizer> sync_;
   ros::Publisher odom_pub_, diagnostics_pub_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
 };

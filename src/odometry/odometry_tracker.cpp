@@ -22,22 +22,36 @@ void OdometryTracker::Params::validate() const {
     fail("keyframe_min_overlap", "[0, 1]", keyframe_min_overlap);
   if (lost_frames_before_new_keyframe < 1 || lost_frames_before_new_keyframe > 1000)
     fail("lost_frames_before_new_keyframe", "[1, 1000]", lost_frames_before_new_keyframe);
+  if (!(guess_min_translation > 0 && std::isfinite(guess_min_translation)))
+    fail("guess_min_translation", "(0, inf) m", guess_min_translation);
+  if (!(guess_min_rotation > 0 && guess_min_rotation <= M_PI))
+    fail("guess_min_rotation", "(0, pi] rad", guess_min_rotation);
+  guess.validate();
 }
 
 OdometryTracker::OdometryTracker(const Params& params)
-    : params_((params.validate(), params)), icp_(params.icp) {}
+    : params_((params.validate(), params)), icp_(params.icp), guesser_(params.guess) {}
 
 void OdometryTracker::reset() {
   initialized_ = false;
   icp_.clearReference();
+  keyframe_observations_.clear();
   T_odom_keyframe_ = T_odom_camera_ = last_motion_ = Eigen::Isometry3d::Identity();
   keyframe_covariance_ = covariance_ = Matrix6::Zero();
   last_dt_ = last_stamp_ = 0;
   consecutive_lost_ = 0;
 }
 
-void OdometryTracker::setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics) {
+void OdometryTracker::setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics,
+                                  const std::vector<QuadricMeasurement>* observations) {
   icp_.setReference(cloud, intrinsics);
+  keyframe_observations_.clear();
+  if (observations) {
+    for (const QuadricMeasurement& m : *observations) {
+      keyframe_observations_.push_back(m);
+      keyframe_observations_.back().support_points.clear();  // the guess needs the shapes only
+    }
+  }
   T_odom_keyframe_ = T_odom_camera_;
   keyframe_covariance_ = covariance_;
 }
@@ -55,8 +69,36 @@ OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_
   return out;
 }
 
+PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
+    const Cloud& cloud, const Eigen::Isometry3d& T_keyframe_prior,
+    const std::vector<QuadricMeasurement>* observations, Result& out) {
+  PointToPlaneIcp::Result from_prior = icp_.align(cloud, T_keyframe_prior);
+  if (!params_.quadric_motion_guess || !observations || keyframe_observations_.empty())
+    return from_prior;
+  out.guess = guesser_.guess(keyframe_observations_, *observations, T_keyframe_prior);
+  if (!out.guess.found)
+    return from_prior;
+  const Eigen::Isometry3d difference = T_keyframe_prior.inverse() * out.guess.T_reference_current;
+  if (difference.translation().norm() < params_.guess_min_translation &&
+      pose_math::rotationAngle(difference) < params_.guess_min_rotation)
+    return from_prior;  // the prior already starts where the surfaces say
+  PointToPlaneIcp::Result from_guess = icp_.align(cloud, out.guess.T_reference_current);
+  const auto lost = [](const PointToPlaneIcp::Result& r) { return r.status == TrackingStatus::kLost; };
+  bool guess_better = false;
+  if (lost(from_prior) != lost(from_guess)) {
+    guess_better = lost(from_prior);
+  } else if (from_guess.correspondences > 1.02 * from_prior.correspondences) {
+    guess_better = true;
+  } else if (from_prior.correspondences <= 1.02 * from_guess.correspondences) {
+    guess_better = from_guess.rms_residual < from_prior.rms_residual;
+  }
+  out.started_from_guess = guess_better;
+  return guess_better ? from_guess : from_prior;
+}
+
 OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
-                                               const CameraIntrinsics& intrinsics, double stamp) {
+                                               const CameraIntrinsics& intrinsics, double stamp,
+                                               const std::vector<QuadricMeasurement>* observations) {
   std::string problem;
   if (organizedCloudDecimation(intrinsics, static_cast<int>(cloud.width),
                                static_cast<int>(cloud.height), &problem) == 0)
@@ -72,7 +114,7 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     }
     T_odom_camera_ = Eigen::Isometry3d::Identity();
     covariance_ = Matrix6::Zero();
-    setKeyframe(cloud, intrinsics);
+    setKeyframe(cloud, intrinsics, observations);
     initialized_ = true;
     last_motion_ = Eigen::Isometry3d::Identity();
     last_dt_ = 0;
@@ -92,7 +134,9 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
         pose_math::orthonormalized(T_odom_camera_ * pose_math::scaleMotion(last_motion_, k));
   }
   const Eigen::Isometry3d T_keyframe_odom = T_odom_keyframe_.inverse();
-  PointToPlaneIcp::Result icp = icp_.align(cloud, T_keyframe_odom * prediction);
+  Result out;
+  PointToPlaneIcp::Result icp =
+      alignFromBestStart(cloud, T_keyframe_odom * prediction, observations, out);
 
   const Eigen::Isometry3d previous = T_odom_camera_;
   bool new_keyframe = false;
@@ -102,7 +146,7 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     last_motion_ = Eigen::Isometry3d::Identity();
     covariance_ += Matrix6::Identity() * params_.icp.degenerate_variance;
     if (consecutive_lost_ >= params_.lost_frames_before_new_keyframe && usable()) {
-      setKeyframe(cloud, intrinsics);
+      setKeyframe(cloud, intrinsics, observations);
       new_keyframe = true;
     }
   } else {
@@ -117,15 +161,17 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     if (from_keyframe.translation().norm() > params_.keyframe_translation ||
         pose_math::rotationAngle(from_keyframe) > params_.keyframe_rotation ||
         icp.inlier_fraction < params_.keyframe_min_overlap) {
-      setKeyframe(cloud, intrinsics);
+      setKeyframe(cloud, intrinsics, observations);
       new_keyframe = true;
     }
   }
   last_dt_ = dt > 0 ? dt : 0;
   last_stamp_ = stamp;
-  Result out = output(icp.status, new_keyframe);
-  out.icp = std::move(icp);
-  return out;
+  Result result = output(icp.status, new_keyframe);
+  result.icp = std::move(icp);
+  result.guess = std::move(out.guess);
+  result.started_from_guess = out.started_from_guess;
+  return result;
 }
 
 }  // namespace quadric_slam

@@ -40,6 +40,19 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "keyframe_min_overlap", params.keyframe_min_overlap, log);
   readParam(reader, "constant_velocity", params.constant_velocity, log);
   readParam(reader, "lost_frames_before_new_keyframe", params.lost_frames_before_new_keyframe, log);
+  readParam(reader, "quadric_motion_guess", params.quadric_motion_guess, log);
+  readParam(reader, "guess_min_translation", params.guess_min_translation, log);
+  readParam(reader, "guess_min_rotation", params.guess_min_rotation, log);
+  QuadricMotionGuesser::Params& guess = params.guess;
+  readParam(reader, "guess_max_angle_difference", guess.max_angle_difference, log);
+  readParam(reader, "guess_max_offset_difference", guess.max_offset_difference, log);
+  readParam(reader, "guess_max_radius_fraction", guess.max_radius_fraction, log);
+  readParam(reader, "guess_min_pair_angle", guess.min_pair_angle, log);
+  readParam(reader, "guess_min_plane_points", guess.min_plane_points, log);
+  readParam(reader, "guess_max_direction_features", guess.max_direction_features, log);
+  readParam(reader, "guess_max_rotation_from_prior", guess.max_rotation_from_prior, log);
+  readParam(reader, "guess_max_translation_from_prior", guess.max_translation_from_prior, log);
+  readParam(reader, "guess_min_supporting_surfaces", guess.min_supporting_surfaces, log);
   params.validate();
 }
 

@@ -91,7 +91,11 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
     out.measurements = toFrameMeasurements(segmentation_, frame.stamp, frame.frame_id);
     attachSupportPoints(out.measurements, segmentation_, cloud_, params_.max_support_points);
   }
-  out.odometry = timer_.time("odometry", [&] { return odometry_.track(cloud_, k, frame.stamp); });
+  // The segmentation's surfaces give the odometry a motion guess for large steps.
+  out.odometry = timer_.time("odometry", [&] {
+    return odometry_.track(cloud_, k, frame.stamp,
+                           params_.mapping_enabled ? &out.measurements.observations : nullptr);
+  });
   out.tracking = odometry_.initialized();
   if (!params_.mapping_enabled || !out.tracking)
     return out;

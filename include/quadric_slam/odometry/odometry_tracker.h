@@ -6,8 +6,12 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "quadric_slam/types/camera_intrinsics.h"
+#include <vector>
+
 #include "quadric_slam/odometry/point_to_plane_icp.h"
+#include "quadric_slam/odometry/quadric_motion_guess.h"
+#include "quadric_slam/types/camera_intrinsics.h"
+#include "quadric_slam/types/observation.h"
 
 namespace quadric_slam {
 
@@ -31,6 +35,15 @@ class OdometryTracker {
     // After this many consecutive lost frames the current frame becomes the keyframe (at the last
     // pose), so tracking can resume. [1, 1000]
     int lost_frames_before_new_keyframe = 3;
+    // When the frame's quadric observations are given: guess the motion from the surfaces the frame
+    // shares with the keyframe (odometry/quadric_motion_guess.h) and, when the guess differs from
+    // the constant-velocity prior by more than guess_min_translation or guess_min_rotation (m, rad,
+    // > 0), run ICP from both and keep the better alignment (more inlier correspondences; at equal
+    // counts within 2%, the smaller residual).
+    bool quadric_motion_guess = true;
+    double guess_min_translation = 0.02;
+    double guess_min_rotation = 0.035;
+    QuadricMotionGuesser::Params guess;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -45,6 +58,8 @@ class OdometryTracker {
     bool new_keyframe = false;    // this frame became the keyframe
     int consecutive_lost = 0;     // lost frames in a row, this one included
     PointToPlaneIcp::Result icp;  // details of the alignment (empty for the first frame)
+    QuadricMotionGuess guess;     // the surfaces' motion guess (found = false when not made)
+    bool started_from_guess = false;  // ICP's result came from the guess, not the prior
   };
 
   explicit OdometryTracker(const Params& params);
@@ -53,7 +68,10 @@ class OdometryTracker {
   // of the full-resolution image the cloud was made from (it may be decimated). The first usable
   // frame defines the odom frame (T_odom_camera = identity). Throws std::invalid_argument only when
   // the cloud's size does not fit the intrinsics; bad data otherwise gives status lost.
-  Result track(const Cloud& cloud, const CameraIntrinsics& intrinsics, double stamp);
+  // observations: the frame's quadric observations (camera frame), for the motion guess; nullptr
+  // tracks from the constant-velocity prior alone.
+  Result track(const Cloud& cloud, const CameraIntrinsics& intrinsics, double stamp,
+               const std::vector<QuadricMeasurement>* observations = nullptr);
 
   // Forgets the keyframe, pose and velocity: the next usable frame starts a new odom frame.
   void reset();
@@ -63,11 +81,20 @@ class OdometryTracker {
   const Params& params() const { return params_; }
 
  private:
-  void setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics);
+  void setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics,
+                   const std::vector<QuadricMeasurement>* observations);
+  // ICP from the prior, and from the surfaces' guess when it differs; the better of the two.
+  PointToPlaneIcp::Result alignFromBestStart(const Cloud& cloud,
+                                             const Eigen::Isometry3d& T_keyframe_prior,
+                                             const std::vector<QuadricMeasurement>* observations,
+                                             Result& out);
   Result output(TrackingStatus status, bool new_keyframe) const;
 
   Params params_;
   PointToPlaneIcp icp_;
+  QuadricMotionGuesser guesser_;
+  // The keyframe's observations without their supporting points (empty when none were given).
+  std::vector<QuadricMeasurement> keyframe_observations_;
   bool initialized_ = false;
   Eigen::Isometry3d T_odom_keyframe_ = Eigen::Isometry3d::Identity();
   Matrix6 keyframe_covariance_ = Matrix6::Zero();  // left perturbation in odom, (v, omega)

@@ -66,10 +66,12 @@ TEST(PipelineParams, OdometryYamlKeysAreAllRead) {
   std::string frame;
   bool publish_tf = true;
   int queue_size = 5;
+  bool use_observations = false;
   qs::readParam(reader, "odom_frame", frame, log);
   qs::readParam(reader, "camera_frame", frame, log);
   qs::readParam(reader, "publish_tf", publish_tf, log);
   qs::readParam(reader, "queue_size", queue_size, log);
+  qs::readParam(reader, "use_observations", use_observations, log);
   for (const auto& entry : file) {
     const std::string key = entry.first.as<std::string>();
     EXPECT_NE(log.str().find("\n  " + key + ": "), std::string::npos)
@@ -77,4 +79,6 @@ TEST(PipelineParams, OdometryYamlKeysAreAllRead) {
   }
   EXPECT_EQ(params.icp.pyramid_levels, file["pyramid_levels"].as<int>());
   EXPECT_DOUBLE_EQ(params.keyframe_translation, file["keyframe_translation"].as<double>());
+  EXPECT_EQ(params.quadric_motion_guess, file["quadric_motion_guess"].as<bool>());
+  EXPECT_EQ(params.guess.max_direction_features, file["guess_max_direction_features"].as<int>());
 }
