@@ -228,7 +228,7 @@ void QuadricMapper::loadLandmarks(const std::vector<QuadricLandmark>& landmarks,
   if (!isRigid(T_map_odom))
     throw std::invalid_argument("QuadricMapper::loadLandmarks: T_map_odom is not rigid");
   // Validate on a scratch map first, so that a bad list leaves the mapper as it was.
-  QuadricMap scratch(params_.map);
+  LandmarkRegistry scratch(params_.map);
   for (const QuadricLandmark& landmark : landmarks)
     scratch.insertLandmark(landmark);
   reset();
@@ -247,7 +247,8 @@ void QuadricMapper::setLocalizationOnly(bool on) {
 }
 
 int addKeyframeToReconstruction(const FrameMeasurements& frame, const MapperFrameResult& result,
-                                const QuadricMap& map, QuadricReconstruction* reconstruction) {
+                                const LandmarkRegistry& map,
+                                QuadricReconstruction* reconstruction) {
   int stored = 0;
   // result.update.measurements lists the accepted measurements in input order, the rejected left
   // out: walk the input alongside, skipping what process() refused.

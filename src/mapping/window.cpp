@@ -53,7 +53,7 @@ void SlidingWindow::setLandmarkFixed(int landmark_id, bool fixed) {
 }
 
 void SlidingWindow::foldIntoPrior(const Keyframe& keyframe, const WindowObservation& observation,
-                                  const QuadricMap& map) {
+                                  const LandmarkRegistry& map) {
   if (landmarkFixed(observation.landmark_id))
     return;  // a constant block needs no prior
   const QuadricModel& landmark = map.landmark(observation.landmark_id).quadric_map;
@@ -83,7 +83,7 @@ void SlidingWindow::foldIntoPrior(const Keyframe& keyframe, const WindowObservat
   prior.information += 0.5 * (information + information.transpose());
 }
 
-void SlidingWindow::addKeyframe(Keyframe keyframe, const QuadricMap& map) {
+void SlidingWindow::addKeyframe(Keyframe keyframe, const LandmarkRegistry& map) {
   if (!any_keyframe_)
     any_keyframe_ = first_keyframe_in_window_ = true;
   for (const WindowObservation& observation : keyframe.observations)
@@ -112,7 +112,7 @@ bool SlidingWindow::addObservation(int frame_index, const WindowObservation& obs
   return false;
 }
 
-WindowStatistics SlidingWindow::optimize(QuadricMap* map) {
+WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
   last_ = WindowStatistics{};
   if (keyframes_.empty())
     return last_;

@@ -3,7 +3,10 @@
 //
 // Subscribes  observations (quadric_slam/QuadricObservationArray, camera optical frame; from
 //             quadric_slam/QuadricSegmentation) and odom (nav_msgs/Odometry, pose of the camera in
-//             ~odom_frame; from quadric_slam/Odometry), paired by exact stamp (message_filters)
+//             ~odom_frame; from quadric_slam/Odometry), paired by exact stamp (message_filters).
+//             The observations are taken to be in odom's child frame (the tracked camera); a
+//             frame id that differs gets a throttled warning (normal_estimation's ~output_frame
+//             names the clouds' frame, odometry's ~camera_frame the tracked one: set them equal).
 // Publishes   map (quadric_slam/QuadricMap in ~map_frame, latched: on keyframes, after a load or
 //             a reset)
 //             markers (visualization_msgs/MarkerArray, latched, with the map)
@@ -56,6 +59,7 @@
 #include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/ros/conversions.h"
+#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/map_files.h"
 #include "quadric_slam/ros/map_publisher.h"
 #include "quadric_slam/ros/params.h"
@@ -65,13 +69,9 @@ namespace quadric_slam {
 
 namespace {
 
-std::string withoutLeadingSlash(const std::string& frame) {
-  return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
-}
-
 // Empty when the odometry message is usable, else the problem.
 std::string odometryProblem(const nav_msgs::Odometry& odom, const std::string& odom_frame) {
-  if (withoutLeadingSlash(odom.header.frame_id) != withoutLeadingSlash(odom_frame))
+  if (!sameFrame(odom.header.frame_id, odom_frame))
     return "odom is in frame '" + odom.header.frame_id + "', not ~odom_frame '" + odom_frame + "'";
   const auto& p = odom.pose.pose.position;
   const auto& q = odom.pose.pose.orientation;
@@ -129,8 +129,8 @@ class MappingNodelet : public nodelet::Nodelet {
     bool localization_only = false;
     try {
       const RosParamReader reader(private_nh);
-      readParam(reader, "map_frame", map_frame_, log);
-      readParam(reader, "odom_frame", odom_frame_, log);
+      readFrameParam(reader, "map_frame", map_frame_, log);
+      readFrameParam(reader, "odom_frame", odom_frame_, log);
       readParam(reader, "publish_tf", publish_tf_, log);
       readParam(reader, "queue_size", queue_size, log);
       readParam(reader, "reconstruction_every_keyframes", reconstruction_every_keyframes_, log);
@@ -139,8 +139,7 @@ class MappingNodelet : public nodelet::Nodelet {
       readParam(reader, "localization_only", localization_only, log);
       readParam(reader, "diagnostic_period", diagnostic_period, log);
       readMappingParams(reader, mapper_params, reconstruction_params, log);
-      if (map_frame_.empty() || odom_frame_.empty() ||
-          withoutLeadingSlash(map_frame_) == withoutLeadingSlash(odom_frame_))
+      if (map_frame_.empty() || odom_frame_.empty() || map_frame_ == odom_frame_)
         throw std::invalid_argument("map_frame and odom_frame must be non-empty and differ");
       if (queue_size < 1)
         throw std::invalid_argument("queue_size must be >= 1");
@@ -185,7 +184,6 @@ class MappingNodelet : public nodelet::Nodelet {
     }
 
     tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
-    // (The message QuadricMap shares its name with the core class: see ros/map_publisher.h.)
     map_publisher_ = QuadricMapPublisher(nh, "map", "markers");
     reconstruction_pub_ = nh.advertise<sensor_msgs::PointCloud2>("reconstruction", 1, true);
     path_pub_ = nh.advertise<nav_msgs::Path>("path", queue_size);
@@ -271,6 +269,7 @@ class MappingNodelet : public nodelet::Nodelet {
       dropFrame(problem);
       return;
     }
+    checkObservationFrame(observations.header.frame_id, odom.child_frame_id);
     OdometryInput odometry;
     odometry.T_odom_camera = fromPoseMsg(odom.pose.pose);
     // The odometry's covariance is cumulative since its start: like QuadricSlam, the mapper uses
@@ -279,7 +278,7 @@ class MappingNodelet : public nodelet::Nodelet {
     // 3. Observations: those that do not convert are dropped, the rest of the frame is used.
     FrameMeasurements frame;
     frame.stamp = stamp.toSec();
-    frame.frame_id = observations.header.frame_id;
+    frame.frame_id = withoutLeadingSlash(observations.header.frame_id);
     frame.observations.reserve(observations.observations.size());
     int bad = 0;
     std::string why;
@@ -368,6 +367,26 @@ class MappingNodelet : public nodelet::Nodelet {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
 
+  // The observations are used in the frame whose pose odom gives (its child frame). Another frame
+  // id is most likely the same sensor under another name (normal_estimation's ~output_frame unset,
+  // a bag's optical frame), so the frame is used, with a warning and both names on /diagnostics.
+  void checkObservationFrame(const std::string& observation_frame,
+                             const std::string& camera_frame) {
+    const std::string observed = withoutLeadingSlash(observation_frame);
+    const std::string camera = withoutLeadingSlash(camera_frame);
+    if (observed != camera) {
+      NODELET_WARN_THROTTLE(
+          30.0,
+          "mapping: observations are in frame '%s', but odom gives the pose of '%s'; they are "
+          "used as if in '%s' (set normal_estimation's ~output_frame to odometry's "
+          "~camera_frame)",
+          observed.c_str(), camera.c_str(), camera.c_str());
+    }
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    stats_.observation_frame = observed;
+    stats_.camera_frame = camera;
+  }
+
   // Forgets the map (back to the loaded one, if any), the reconstruction and the path.
   void reset() {
     mapper_->reset();
@@ -425,7 +444,7 @@ class MappingNodelet : public nodelet::Nodelet {
                     : " and " + std::to_string(points) + " reconstruction points from " +
                           base->map.reconstruction_path) +
                (localization_only ? "; localisation only" : "; mapping on");
-    if (withoutLeadingSlash(base->map.frame_id) != withoutLeadingSlash(map_frame_))
+    if (!sameFrame(base->map.frame_id, map_frame_))
       *message += "; the file's frame '" + base->map.frame_id + "' is taken as ~map_frame '" +
                   map_frame_ + "'";
     base_map_ = std::move(base);
@@ -436,15 +455,24 @@ class MappingNodelet : public nodelet::Nodelet {
     return true;
   }
 
+  // The file a ~save_map or ~load_map request means: its path, else ~map_file. "" when neither is
+  // set, with the response failed and saying so.
+  template <typename Response>
+  std::string mapPathFor(const std::string& requested_path, Response& response) const {
+    const std::string path = requested_path.empty() ? map_file_ : requested_path;
+    if (path.empty()) {
+      response.success = false;
+      response.message = "no path given and ~map_file is empty";
+    }
+    return path;
+  }
+
   bool onSaveMap(SaveMap::Request& request, SaveMap::Response& response) {
     try {
       std::lock_guard<std::mutex> lock(mutex_);
-      const std::string path = request.path.empty() ? map_file_ : request.path;
-      if (path.empty()) {
-        response.success = false;
-        response.message = "no path given and ~map_file is empty";
+      const std::string path = mapPathFor(request.path, response);
+      if (path.empty())
         return true;
-      }
       const std::vector<QuadricLandmark> landmarks = mapper_->landmarks();
       const sensor_msgs::PointCloud2Ptr cloud = reconstructionCloud(ros::Time::now());
       saveMapFiles(path, landmarks, map_frame_, *cloud);
@@ -469,12 +497,9 @@ class MappingNodelet : public nodelet::Nodelet {
   bool onLoadMap(LoadMap::Request& request, LoadMap::Response& response) {
     try {
       std::lock_guard<std::mutex> lock(mutex_);
-      const std::string path = request.path.empty() ? map_file_ : request.path;
-      if (path.empty()) {
-        response.success = false;
-        response.message = "no path given and ~map_file is empty";
+      const std::string path = mapPathFor(request.path, response);
+      if (path.empty())
         return true;
-      }
       response.success = loadMap(path, request.localization_only, &response.message);
       if (response.success) {
         response.num_quadrics = static_cast<std::uint32_t>(mapper_->map().landmarks().size());
@@ -550,6 +575,7 @@ class MappingNodelet : public nodelet::Nodelet {
     double solve_ms = 0.0, association_ms = 0.0, processing_ms = 0.0;
     std::map<std::string, int> landmarks_per_class;
     int landmarks = 0, candidates = 0;
+    std::string observation_frame, camera_frame;  // of the latest frame (observations, odom child)
     std::string mode = "mapping";  // or "localisation only"
     std::string loaded_from;       // the loaded map file, if any
     // At the previous report.
@@ -615,6 +641,8 @@ class MappingNodelet : public nodelet::Nodelet {
     status.add("observations received", s.observations);
     status.add("observations dropped", s.observations_dropped);
     status.add("last observation problem", s.last_observation_problem);
+    status.add("observation frame", s.observation_frame);
+    status.add("camera frame (odom child)", s.camera_frame);
     status.add("observation messages", s.observation_messages);
     status.add("odom messages", s.odom_messages);
     status.add("synchronised pairs", s.synchronised);

@@ -4,7 +4,8 @@
 //             depth/camera_info (sensor_msgs/CameraInfo, the latest one is used)
 // Parameters  config/normal_estimation.yaml (every key documented there)
 // Publishes   points_normals (sensor_msgs/PointCloud2, organized, fields x y z normal_x normal_y
-//             normal_z curvature, NaN where there is no data, the depth image's stamp and frame)
+//             normal_z curvature, NaN where there is no data, the depth image's stamp; frame
+//             ~output_frame, or the image's frame id when that is empty, without a leading '/')
 //             /diagnostics (health: frames processed and dropped, last reason)
 // Bad input (no camera_info yet, unsupported encoding, size mismatch, malformed buffer) gets a
 // throttled error and the frame is dropped.
@@ -23,6 +24,7 @@
 #include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
+#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/params.h"
 
 namespace quadric_slam {
@@ -39,6 +41,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     try {
       const RosParamReader params(private_nh);
       readNormalEstimationParams(params, back_projection_, normal_params, log);
+      readFrameParam(params, "output_frame", output_frame_, log);
       readParam(params, "queue_size", queue_size, log);
       estimator_ = std::make_unique<NormalEstimator>(normal_params);
     } catch (const std::invalid_argument& e) {
@@ -87,6 +90,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     auto msg = boost::make_shared<sensor_msgs::PointCloud2>();
     pcl::toROSMsg(with_normals_, *msg);
     msg->header = image->header;
+    msg->header.frame_id = outputFrameId(output_frame_, image->header.frame_id);
     cloud_pub_.publish(msg);
     diagnostics_->frameProcessed(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -99,6 +103,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
   }
 
   BackProjectionParams back_projection_;
+  std::string output_frame_;  // "" = the image's frame
   std::unique_ptr<NormalEstimator> estimator_;
   // Output storage reused from frame to frame (a subscription's callbacks never run concurrently).
   pcl::PointCloud<pcl::PointNormal> with_normals_;

@@ -12,7 +12,9 @@
 // Publishes   odom (nav_msgs/Odometry: pose of ~camera_frame in ~odom_frame with covariance)
 //             tf ~odom_frame -> ~camera_frame (when ~publish_tf)
 //             /diagnostics (diagnostic_msgs/DiagnosticArray, at most once a second)
-// All parameters are documented in config/odometry.yaml.
+// All parameters are documented in config/odometry.yaml. The cloud's own frame id is not used: the
+// pose is that of ~camera_frame, our name for the tracked optical frame (normal_estimation's
+// ~output_frame gives the clouds the same name in quadric_slam.launch).
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
@@ -39,6 +41,7 @@
 #include "quadric_slam/odometry/odometry_tracker.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/depth_image.h"
+#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/params.h"
 #include "quadric_slam/ros/points_normals.h"
 
@@ -55,8 +58,8 @@ class OdometryNodelet : public nodelet::Nodelet {
     int queue_size = 5;
     try {
       const RosParamReader reader(private_nh);
-      readParam(reader, "odom_frame", odom_frame_, log);
-      readParam(reader, "camera_frame", camera_frame_, log);
+      readFrameParam(reader, "odom_frame", odom_frame_, log);
+      readFrameParam(reader, "camera_frame", camera_frame_, log);
       readParam(reader, "publish_tf", publish_tf_, log);
       readOdometryParams(reader, params, log);
       readParam(reader, "queue_size", queue_size, log);

@@ -4,7 +4,8 @@
 // Subscribes  points_normals (sensor_msgs/PointCloud2, organized, fields x y z normal_x normal_y
 //             normal_z [curvature], NaN where unknown; e.g. from quadric_slam/NormalEstimation)
 // Parameters  config/segmentation.yaml (every key documented there)
-// Publishes   observations (quadric_slam/QuadricObservationArray, the cloud's stamp and frame; an
+// Publishes   observations (quadric_slam/QuadricObservationArray, the cloud's stamp and frame
+//             (without a leading '/', as on every output: tf2 and rviz refuse it); an
 //             empty array when the frame holds no quadric, e.g. an empty or all-NaN cloud)
 //             (each with at most ~max_support_points supporting points for the reconstruction)
 //             ~segmentation_image (sensor_msgs/Image rgb8, a colour per segment; only computed
@@ -33,6 +34,7 @@
 #include "quadric_slam/pipeline/segmenter_params.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/diagnostics.h"
+#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/params.h"
 
 namespace quadric_slam {
@@ -112,20 +114,23 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
       }
       const Segmentation segmentation = segmenter_->segment(cloud);
 
+      // Every output carries the cloud's header, its frame id without a leading '/'.
+      std_msgs::Header header = msg->header;
+      header.frame_id = withoutLeadingSlash(header.frame_id);
       // Core measurements (detection_measurement.h) -> messages (ros/conversions.h); the header is
-      // the cloud's, copied exactly (the conversion goes through a double stamp).
+      // copied exactly (the conversion goes through a double stamp).
       FrameMeasurements measurements =
-          toFrameMeasurements(segmentation, msg->header.stamp.toSec(), msg->header.frame_id);
+          toFrameMeasurements(segmentation, header.stamp.toSec(), header.frame_id);
       attachSupportPoints(measurements, segmentation, cloud, max_support_points_);
       auto out = boost::make_shared<QuadricObservationArray>(toObservationArrayMsg(
           measurements));
-      out->header = msg->header;
+      out->header = header;
       observations_pub_.publish(out);
 
       if (image_pub_.getNumSubscribers() > 0)
-        publishImage(segmentation, msg->header);
+        publishImage(segmentation, header);
       if (cloud_pub_.getNumSubscribers() > 0)
-        publishCloud(cloud, segmentation, msg->header);
+        publishCloud(cloud, segmentation, header);
     } catch (const std::exception& e) {
       NODELET_ERROR_THROTTLE(5.0, "quadric_segmentation: dropping cloud: %s", e.what());
       diagnostics_->frameDropped(e.what());

@@ -58,7 +58,7 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
 
 void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
                        QuadricReconstruction::Params& reconstruction, ParamLog& log) {
-  QuadricMap::Params& map = mapper.map;
+  LandmarkRegistry::Params& map = mapper.map;
   readParam(reader, "min_observations", map.min_observations, log);
   readParam(reader, "candidate_timeout_frames", map.candidate_timeout_frames, log);
   QuadricAssociator::Params& association = map.association;

@@ -6,6 +6,7 @@
 
 #include "quadric_slam/geometry/quadric_class.h"
 #include "quadric_slam/geometry/shapes.h"
+#include "quadric_slam/ros/frame_ids.h"
 
 namespace quadric_slam {
 namespace {
@@ -155,7 +156,7 @@ QuadricMeasurement fromObservationMsg(const QuadricObservation& msg) {
 QuadricObservationArray toObservationArrayMsg(const FrameMeasurements& frame) {
   QuadricObservationArray msg;
   msg.header.stamp = ros::Time(frame.stamp);
-  msg.header.frame_id = frame.frame_id;
+  msg.header.frame_id = withoutLeadingSlash(frame.frame_id);
   msg.observations.reserve(frame.observations.size());
   for (const QuadricMeasurement& m : frame.observations) {
     msg.observations.push_back(toObservationMsg(m));
@@ -166,7 +167,7 @@ QuadricObservationArray toObservationArrayMsg(const FrameMeasurements& frame) {
 FrameMeasurements fromObservationArrayMsg(const QuadricObservationArray& msg, int* rejected) {
   FrameMeasurements frame;
   frame.stamp = msg.header.stamp.toSec();
-  frame.frame_id = msg.header.frame_id;
+  frame.frame_id = withoutLeadingSlash(msg.header.frame_id);
   int bad = 0;
   for (const QuadricObservation& observation : msg.observations) {
     try {

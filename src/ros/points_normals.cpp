@@ -3,6 +3,8 @@
 #include <cstring>
 #include <sstream>
 
+#include "quadric_slam/ros/frame_ids.h"
+
 namespace quadric_slam {
 namespace {
 
@@ -40,7 +42,7 @@ std::string pointsNormalsFromMsg(const sensor_msgs::PointCloud2& msg,
         << msg.point_step << ", row_step " << msg.row_step << ", " << msg.data.size() << " bytes)";
     return why.str();
   }
-  cloud.header.frame_id = msg.header.frame_id;
+  cloud.header.frame_id = withoutLeadingSlash(msg.header.frame_id);
   cloud.width = msg.width;
   cloud.height = msg.height;
   cloud.is_dense = false;

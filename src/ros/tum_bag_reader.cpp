@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "quadric_slam/io/stamp_association.h"
+#include "quadric_slam/ros/frame_ids.h"
 
 namespace quadric_slam {
 namespace {
@@ -232,7 +233,7 @@ bool TumBagReader::next(RgbdFrame& frame) {
   if (!depth)
     throw std::runtime_error(d.params.depth_topic + ": cannot decode sensor_msgs/Image");
   frame.stamp = depth->header.stamp.toSec();
-  frame.frame_id = depth->header.frame_id;
+  frame.frame_id = withoutLeadingSlash(depth->header.frame_id);  // TUM's "/openni_..."
   frame.depth_m = depthToMetres(*depth, d.params.depth_topic);
   frame.intrinsics = d.intrinsics;
   if (frame.intrinsics.width == 0 && frame.intrinsics.height == 0) {

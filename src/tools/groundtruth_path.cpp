@@ -22,26 +22,23 @@
 //                  odometry is this much younger is skipped; default 2.0
 //   ~publish_period  s (message time) between path messages; default 0.5
 // TUM bags name their frames with a leading '/', which tf2 strips when it stores a transform and
-// rejects in a lookup: every frame id is looked up without it.
+// rejects in a lookup: every frame id is used without it (ros/frame_ids.h).
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <ros/ros.h>
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_ros/transform_listener.h>
 
-#include <deque>
 #include <mutex>
 #include <optional>
 
 #include "quadric_slam/io/trajectory_io.h"
+#include "quadric_slam/ros/frame_ids.h"
+#include "quadric_slam/ros/tf_lookup.h"
 
 namespace qs = quadric_slam;
 
 namespace {
-
-std::string tf2FrameId(const std::string& frame) {
-  return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
-}
 
 geometry_msgs::PoseStamped toPoseStamped(const Eigen::Isometry3d& T, const ros::Time& stamp,
                                          const std::string& frame) {
@@ -68,70 +65,62 @@ int main(int argc, char** argv) {
   private_nh.param("file", file, file);
   private_nh.param("max_delay", max_delay, max_delay);
   private_nh.param("publish_period", publish_period, publish_period);
-  world_frame = tf2FrameId(world_frame);
-  frame = tf2FrameId(frame);
-  map_frame = tf2FrameId(map_frame);
-  camera_frame = tf2FrameId(camera_frame);
+  world_frame = qs::withoutLeadingSlash(world_frame);
+  frame = qs::withoutLeadingSlash(frame);
+  map_frame = qs::withoutLeadingSlash(map_frame);
+  camera_frame = qs::withoutLeadingSlash(camera_frame);
 
   tf2_ros::Buffer buffer(ros::Duration(30.0));
   tf2_ros::TransformListener listener(buffer);
   ros::Publisher path_pub = nh.advertise<nav_msgs::Path>("groundtruth_path", 1, true);
 
   std::mutex mutex;
-  std::deque<ros::Time> pending;
-  ros::Time newest, last_published;
+  // Each odometry stamp waits for the bag's world -> frame and, until the anchor is set, our
+  // map -> camera.
+  qs::PendingTfLookups pending(max_delay);
+  const qs::TfLookup truth_lookup{world_frame, frame}, our_lookup{map_frame, camera_frame};
+  ros::Time last_published;
   std::optional<Eigen::Isometry3d> T_map_world;  // the anchor
   nav_msgs::Path path;
   path.header.frame_id = map_frame;
   qs::Trajectory truth;  // world -> frame, for ~file
-  size_t skipped = 0;
-  std::string last_error;
 
   // Resolves the pending stamps in order; with `final`, skips whatever cannot be resolved.
   auto resolve = [&](bool final) {
-    bool added = false;
-    while (!pending.empty()) {
-      const ros::Time stamp = pending.front();
-      std::string error;
-      const bool have_truth = buffer.canTransform(world_frame, frame, stamp, &error);
-      const bool have_ours =
-          T_map_world.has_value() || buffer.canTransform(map_frame, camera_frame, stamp, &error);
-      if (have_truth && have_ours) {
-        const Eigen::Isometry3d T_world_optical =
-            tf2::transformToEigen(buffer.lookupTransform(world_frame, frame, stamp));
-        if (!T_map_world) {
-          const Eigen::Isometry3d T_map_camera =
-              tf2::transformToEigen(buffer.lookupTransform(map_frame, camera_frame, stamp));
-          T_map_world = T_map_camera * T_world_optical.inverse();
-          ROS_INFO("groundtruth_path: %s -> %s anchored to %s -> %s at t = %.3f s",
-                   world_frame.c_str(), frame.c_str(), map_frame.c_str(), camera_frame.c_str(),
-                   stamp.toSec());
-        }
-        path.poses.push_back(toPoseStamped(*T_map_world * T_world_optical, stamp, map_frame));
-        truth.push_back({stamp.toSec(), T_world_optical});
-        added = true;
-      } else if (final || (newest - stamp).toSec() > max_delay) {
-        ++skipped;
-        last_error = error;
-        ROS_WARN_THROTTLE(10.0, "groundtruth_path: no pose at t = %.3f s: %s", stamp.toSec(),
-                          error.c_str());
-      } else {
-        break;  // its transforms may still come
-      }
-      pending.pop_front();
+    const std::size_t skipped_before = pending.givenUp();
+    const std::vector<qs::PendingTfLookups::Resolved> resolved = pending.resolve(buffer, final);
+    if (pending.givenUp() > skipped_before) {
+      ROS_WARN_THROTTLE(10.0, "groundtruth_path: %zu stamps without a pose (last: %s)",
+                        pending.givenUp(), pending.lastError().c_str());
     }
-    if (added && (final || (newest - last_published).toSec() >= publish_period)) {
+    for (const qs::PendingTfLookups::Resolved& pose : resolved) {
+      const Eigen::Isometry3d& T_world_optical = pose.transforms[0];
+      if (!T_map_world) {
+        // Stamps added before the anchor was set wait for map -> camera too (transforms[1]).
+        const Eigen::Isometry3d& T_map_camera = pose.transforms.at(1);
+        T_map_world = T_map_camera * T_world_optical.inverse();
+        ROS_INFO("groundtruth_path: %s -> %s anchored to %s -> %s at t = %.3f s",
+                 world_frame.c_str(), frame.c_str(), map_frame.c_str(), camera_frame.c_str(),
+                 pose.stamp.toSec());
+      }
+      path.poses.push_back(toPoseStamped(*T_map_world * T_world_optical, pose.stamp, map_frame));
+      truth.push_back({pose.stamp.toSec(), T_world_optical});
+    }
+    if (!resolved.empty() &&
+        (final || (pending.newest() - last_published).toSec() >= publish_period)) {
       path.header.stamp = path.poses.back().header.stamp;
       path_pub.publish(path);
-      last_published = newest;
+      last_published = pending.newest();
     }
   };
 
   ros::Subscriber sub =
       nh.subscribe<nav_msgs::Odometry>(topic, 100, [&](const nav_msgs::OdometryConstPtr& odom) {
         std::lock_guard<std::mutex> lock(mutex);
-        newest = std::max(newest, odom->header.stamp);
-        pending.push_back(odom->header.stamp);
+        if (T_map_world)
+          pending.add(odom->header.stamp, {truth_lookup});
+        else
+          pending.add(odom->header.stamp, {truth_lookup, our_lookup});
         resolve(false);
       });
   ros::WallTimer timer =
@@ -147,8 +136,9 @@ int main(int argc, char** argv) {
   std::lock_guard<std::mutex> lock(mutex);
   resolve(true);
   std::printf("groundtruth_path: %zu poses", path.poses.size());
-  if (skipped > 0)
-    std::printf(", %zu stamps without a pose (last: %s)", skipped, last_error.c_str());
+  if (pending.givenUp() > 0)
+    std::printf(", %zu stamps without a pose (last: %s)", pending.givenUp(),
+                pending.lastError().c_str());
   std::printf("\n");
   if (!file.empty()) {
     try {

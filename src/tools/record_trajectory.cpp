@@ -16,26 +16,22 @@
 //   ~child_frame  child frame of the tf lookup; default "" = the message's child_frame_id
 //   ~max_delay    s (message time): a stamp whose transform has not arrived when the newest
 //                 message is this much younger is given up; default 2.0
-// Frame ids are passed to tf2 without a leading '/' (tf2 stores "/world" as "world" and rejects
-// lookups of "/world").
+// Frame ids are used without a leading '/' (ros/frame_ids.h: tf2 stores "/world" as "world" and
+// rejects lookups of "/world").
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
-#include <tf2_eigen/tf2_eigen.h>
 #include <tf2_ros/transform_listener.h>
 
-#include <deque>
 #include <memory>
 #include <mutex>
 
 #include "quadric_slam/io/trajectory_io.h"
+#include "quadric_slam/ros/frame_ids.h"
+#include "quadric_slam/ros/tf_lookup.h"
 
 namespace qs = quadric_slam;
 
 namespace {
-
-std::string tf2FrameId(const std::string& frame) {
-  return !frame.empty() && frame[0] == '/' ? frame.substr(1) : frame;
-}
 
 Eigen::Isometry3d toIsometry(const geometry_msgs::Pose& p) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -59,8 +55,8 @@ int main(int argc, char** argv) {
   private_nh.param("frame", frame, frame);
   private_nh.param("child_frame", child_frame, child_frame);
   private_nh.param("max_delay", max_delay, max_delay);
-  frame = tf2FrameId(frame);
-  child_frame = tf2FrameId(child_frame);
+  frame = qs::withoutLeadingSlash(frame);
+  child_frame = qs::withoutLeadingSlash(child_frame);
 
   std::unique_ptr<tf2_ros::Buffer> buffer;
   std::unique_ptr<tf2_ros::TransformListener> listener;
@@ -71,31 +67,13 @@ int main(int argc, char** argv) {
 
   std::mutex mutex;
   qs::Trajectory trajectory;
-  struct Pending {
-    ros::Time stamp;
-    std::string child;
-  };
-  std::deque<Pending> pending;  // stamps waiting for their transform (tf mode)
-  ros::Time newest;
-  size_t given_up = 0;
-  std::string last_error, recorded_child = child_frame;
+  qs::PendingTfLookups pending(max_delay);  // stamps waiting for their transform (tf mode)
+  std::string recorded_child = child_frame;
 
   // Resolves the pending stamps in order; with `final`, gives up on whatever cannot be resolved.
   auto resolve = [&](bool final) {
-    while (!pending.empty()) {
-      const Pending& p = pending.front();
-      std::string error;
-      if (buffer->canTransform(frame, p.child, p.stamp, &error)) {
-        const geometry_msgs::TransformStamped tf = buffer->lookupTransform(frame, p.child, p.stamp);
-        trajectory.push_back({p.stamp.toSec(), tf2::transformToEigen(tf)});
-      } else if (final || (newest - p.stamp).toSec() > max_delay) {
-        ++given_up;
-        last_error = error;
-      } else {
-        break;  // its transform may still come
-      }
-      pending.pop_front();
-    }
+    for (const qs::PendingTfLookups::Resolved& resolved : pending.resolve(*buffer, final))
+      trajectory.push_back({resolved.stamp.toSec(), resolved.transforms.front()});
   };
 
   ros::Subscriber sub =
@@ -105,10 +83,9 @@ int main(int argc, char** argv) {
           trajectory.push_back({odom->header.stamp.toSec(), toIsometry(odom->pose.pose)});
           return;
         }
-        newest = std::max(newest, odom->header.stamp);
         if (child_frame.empty())
-          recorded_child = tf2FrameId(odom->child_frame_id);
-        pending.push_back({odom->header.stamp, recorded_child});
+          recorded_child = qs::withoutLeadingSlash(odom->child_frame_id);
+        pending.add(odom->header.stamp, {{frame, recorded_child}});
         resolve(false);
       });
   ros::WallTimer timer =
@@ -137,9 +114,9 @@ int main(int argc, char** argv) {
     qs::writeTumTrajectory(trajectory, file, what);
     std::printf("record_trajectory: %zu poses written to %s (%s)\n", trajectory.size(),
                 file.c_str(), what.c_str());
-    if (given_up > 0) {
-      std::printf("record_trajectory: %zu stamps without a transform (last: %s)\n", given_up,
-                  last_error.c_str());
+    if (pending.givenUp() > 0) {
+      std::printf("record_trajectory: %zu stamps without a transform (last: %s)\n",
+                  pending.givenUp(), pending.lastError().c_str());
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "record_trajectory: %s\n", e.what());

@@ -5,6 +5,7 @@
 //
 //   rosrun quadric_slam static_transform x y z qx qy qz qw parent child
 //   rosrun quadric_slam static_transform parent child           (identity)
+// Frame ids are published without a leading '/' (tf2 and rviz refuse it).
 #include <ros/ros.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
@@ -12,6 +13,8 @@
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include "quadric_slam/ros/frame_ids.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "static_transform", ros::init_options::AnonymousName);
@@ -34,6 +37,8 @@ int main(int argc, char** argv) {
   } catch (const std::exception&) {
     args.clear();
   }
+  for (std::string& frame : args)
+    frame = quadric_slam::withoutLeadingSlash(frame);
   const auto& q = tf.transform.rotation;
   const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
   if (args.size() != 2 || args[0].empty() || args[1].empty() || args[0] == args[1] ||

@@ -3,7 +3,7 @@
 //   1. Predict T_map_camera = T_map_kf (T_odom_kf^-1 T_odom_camera) from the latest keyframe's
 //      optimised pose and the odometry since (the paper's "estimated previous pose concatenated
 //      with the latest odometry measurement"), with the odometry covariance accumulated since.
-//   2. Associate and count (mapping/quadric_map.h, mapping/association.h).
+//   2. Associate and count (mapping/landmark_registry.h, mapping/association.h).
 //   3. Keyframe rule: the frame becomes a keyframe when it is the first, when the camera moved more
 //      than keyframe_translation or turned more than keyframe_rotation since the last keyframe
 //      (odometry), or when it observes a landmark that has no factor in the window (a new landmark,
@@ -32,11 +32,11 @@
 #include <string>
 #include <vector>
 
-#include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/se3.h"
-#include "quadric_slam/mapping/quadric_map.h"
+#include "quadric_slam/mapping/landmark_registry.h"
 #include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/mapping/window.h"
+#include "quadric_slam/types/observation.h"
 
 namespace quadric_slam {
 
@@ -70,7 +70,7 @@ struct MapperFrameResult {
 class QuadricMapper {
  public:
   struct Params {
-    QuadricMap::Params map;
+    LandmarkRegistry::Params map;
     SlidingWindow::Params window;
     // Keyframe rule (see above): m (> 0), rad (> 0).
     double keyframe_translation = 0.15;
@@ -119,7 +119,7 @@ class QuadricMapper {
   void setLocalizationOnly(bool on);
   bool localizationOnly() const { return localization_only_; }
 
-  const QuadricMap& map() const { return map_; }
+  const LandmarkRegistry& map() const { return map_; }
   const SlidingWindow& window() const { return window_; }
   // The landmarks as a list (id order).
   std::vector<QuadricLandmark> landmarks() const;
@@ -132,7 +132,7 @@ class QuadricMapper {
   Matrix6d incrementCovariance(const Eigen::Isometry3d& T_previous_this) const;
 
   Params params_;
-  QuadricMap map_;
+  LandmarkRegistry map_;
   SlidingWindow window_;
   int frame_index_ = 0;
   bool has_frame_ = false;
@@ -150,6 +150,6 @@ class QuadricMapper {
 // `frame` holds the measurements given to process() (result.update lists only the accepted ones,
 // in input order). Call it for keyframes. Returns the number of points stored.
 int addKeyframeToReconstruction(const FrameMeasurements& frame, const MapperFrameResult& result,
-                                const QuadricMap& map, QuadricReconstruction* reconstruction);
+                                const LandmarkRegistry& map, QuadricReconstruction* reconstruction);
 
 }  // namespace quadric_slam

@@ -32,9 +32,9 @@
 #include <set>
 #include <vector>
 
-#include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/se3.h"
-#include "quadric_slam/mapping/quadric_map.h"
+#include "quadric_slam/mapping/landmark_registry.h"
+#include "quadric_slam/types/observation.h"
 
 namespace quadric_slam {
 
@@ -96,14 +96,14 @@ class SlidingWindow {
   // Appends a keyframe (its T_map_camera initialised by the caller; its observations must name
   // landmarks of `map`). When the window is over its size the oldest keyframe leaves; landmarks
   // that lose their last window observation leave the problem.
-  void addKeyframe(Keyframe keyframe, const QuadricMap& map);
+  void addKeyframe(Keyframe keyframe, const LandmarkRegistry& map);
   // Adds an observation of a landmark to the window keyframe of frame `frame_index` (the earlier
   // frames of a just-promoted candidate). Returns false when that frame is not a window keyframe.
   bool addObservation(int frame_index, const WindowObservation& observation);
 
   // Optimises the window and writes the estimates back (keyframe poses here, landmarks into the
   // map). When the solver fails or a landmark's estimate becomes invalid, the old estimates stay.
-  WindowStatistics optimize(QuadricMap* map);
+  WindowStatistics optimize(LandmarkRegistry* map);
 
   const std::deque<Keyframe>& keyframes() const { return keyframes_; }
   bool containsLandmark(int landmark_id) const {
@@ -129,7 +129,7 @@ class SlidingWindow {
  private:
   void countObservation(int landmark_id);
   void foldIntoPrior(const Keyframe& keyframe, const WindowObservation& observation,
-                     const QuadricMap& map);
+                     const LandmarkRegistry& map);
 
   Params params_;
   std::deque<Keyframe> keyframes_;

@@ -40,6 +40,7 @@ QuadricObservation toObservationMsg(const QuadricMeasurement& measurement);
 // Throws std::invalid_argument naming the problem (bad surface, covariance of the wrong size).
 QuadricMeasurement fromObservationMsg(const QuadricObservation& msg);
 
+// Both ways the frame id loses a leading '/' (ros/frame_ids.h).
 QuadricObservationArray toObservationArrayMsg(const FrameMeasurements& frame);
 // Observations that fail to convert are skipped and counted in *rejected (when given).
 FrameMeasurements fromObservationArrayMsg(const QuadricObservationArray& msg,

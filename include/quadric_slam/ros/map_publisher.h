@@ -1,9 +1,5 @@
 // Publishes the landmarks as the quadric map (quadric_slam/QuadricMap) and its rviz markers
 // (visualization_msgs/MarkerArray, ros/markers.h), both latched, with one header.
-//
-// The message quadric_slam::QuadricMap and the core class quadric_slam::QuadricMap
-// (mapping/quadric_map.h) share a name, so no translation unit can include both: this header
-// names neither, and the mapping nodelet publishes the map through it.
 #pragma once
 
 #include <ros/node_handle.h>

@@ -13,8 +13,8 @@ namespace quadric_slam {
 namespace {
 
 // Landmarks straight from measurements (min_observations 1), for window tests.
-QuadricMap::Params immediateLandmarks() {
-  QuadricMap::Params p;
+LandmarkRegistry::Params immediateLandmarks() {
+  LandmarkRegistry::Params p;
   p.min_observations = 1;
   return p;
 }
@@ -71,7 +71,7 @@ TEST(SlidingWindow, SmallWindowConvergesWithTheFirstKeyframeFixed) {
   const std::vector<test::TrueLandmark> scene = smallScene();
   const std::vector<Eigen::Isometry3d> poses = cameraLine(5);
   std::mt19937 rng(51);
-  QuadricMap map(immediateLandmarks());
+  LandmarkRegistry map(immediateLandmarks());
   // Landmarks from perturbed measurements at the first pose (1 cm / 0.5 deg scale errors).
   std::vector<QuadricMeasurement> first;
   for (const test::TrueLandmark& l : scene)
@@ -116,7 +116,7 @@ TEST(SlidingWindow, SlidesAndFoldsLeavingObservationsIntoPriors) {
   const std::vector<test::TrueLandmark> scene = smallScene();
   const std::vector<Eigen::Isometry3d> poses = cameraLine(8);
   std::mt19937 rng(52);
-  QuadricMap map(immediateLandmarks());
+  LandmarkRegistry map(immediateLandmarks());
   std::vector<QuadricMeasurement> first;
   for (const test::TrueLandmark& l : scene)
     first.push_back(test::measure(l, poses[0], rng));
@@ -171,7 +171,7 @@ TEST(SlidingWindow, FoldedPriorKeepsTheHistory) {
   const std::vector<Eigen::Isometry3d> poses = cameraLine(12);
   auto finalOffsetError = [&](int keyframes_before) {
     std::mt19937 rng(53);
-    QuadricMap map(immediateLandmarks());
+    LandmarkRegistry map(immediateLandmarks());
     const MapUpdate u = map.integrate(1, 0.1, {test::measure(wall, poses[0], rng, 0.0)}, poses[0],
                                       Matrix6d::Zero());
     SlidingWindow::Params p;

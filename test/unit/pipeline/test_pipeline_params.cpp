@@ -21,8 +21,11 @@ TEST(PipelineParams, NormalEstimationYamlKeysAreAllRead) {
   qs::NormalEstimator::Params normals;
   qs::ParamLog log;
   qs::readNormalEstimationParams(qs::YamlParamReader(file), back_projection, normals, log);
-  int queue_size = 5;  // a nodelet-level key, read beside the table
+  // Nodelet-level keys, read beside the table.
+  int queue_size = 5;
+  std::string output_frame;
   qs::readParam(qs::YamlParamReader(file), "queue_size", queue_size, log);
+  qs::readParam(qs::YamlParamReader(file), "output_frame", output_frame, log);
   for (const auto& entry : file) {
     const std::string key = entry.first.as<std::string>();
     EXPECT_NE(log.str().find("\n  " + key + ": "), std::string::npos)

@@ -1,4 +1,4 @@
-#include "quadric_slam/mapping/quadric_map.h"
+#include "quadric_slam/mapping/landmark_registry.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -12,7 +12,7 @@ namespace {
 
 void requireRange(bool ok, const char* field, const char* range) {
   if (!ok)
-    throw std::invalid_argument(std::string("QuadricMap::Params::") + field + " must be in " +
+    throw std::invalid_argument(std::string("LandmarkRegistry::Params::") + field + " must be in " +
                                 range);
 }
 
@@ -35,21 +35,22 @@ ExtentBox observedExtentIn(const QuadricMeasurement& measurement,
 
 }  // namespace
 
-void QuadricMap::Params::validate() const {
+void LandmarkRegistry::Params::validate() const {
   requireRange(min_observations >= 1 && min_observations <= 1000, "min_observations", "[1, 1000]");
   requireRange(candidate_timeout_frames >= 1 && candidate_timeout_frames <= 100000,
                "candidate_timeout_frames", "[1, 100000]");
   association.validate();
 }
 
-QuadricMap::QuadricMap(const Params& params) : params_(params), associator_(params.association) {
+LandmarkRegistry::LandmarkRegistry(const Params& params)
+    : params_(params), associator_(params.association) {
   params_.validate();
 }
 
-MapUpdate QuadricMap::integrate(int frame_index, double stamp,
-                                const std::vector<QuadricMeasurement>& measurements,
-                                const Eigen::Isometry3d& T_map_camera,
-                                const Matrix6d& pose_covariance) {
+MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
+                                      const std::vector<QuadricMeasurement>& measurements,
+                                      const Eigen::Isometry3d& T_map_camera,
+                                      const Matrix6d& pose_covariance) {
   MapUpdate update;
   update.measurements.resize(measurements.size());
 
@@ -174,8 +175,8 @@ MapUpdate QuadricMap::integrate(int frame_index, double stamp,
   return update;
 }
 
-void QuadricMap::setEstimate(int id, const QuadricModel& quadric_map,
-                             const Eigen::MatrixXd& covariance) {
+void LandmarkRegistry::setEstimate(int id, const QuadricModel& quadric_map,
+                                   const Eigen::MatrixXd& covariance) {
   QuadricLandmark& landmark = landmarks_.at(id);
   setLandmarkExtent(&landmark, landmarkExtent(landmark).transformed(quadric_map.pose().inverse() *
                                                                     landmark.quadric_map.pose()));
@@ -183,17 +184,17 @@ void QuadricMap::setEstimate(int id, const QuadricModel& quadric_map,
   landmark.covariance = covariance;
 }
 
-void QuadricMap::insertLandmark(const QuadricLandmark& landmark) {
+void LandmarkRegistry::insertLandmark(const QuadricLandmark& landmark) {
   if (landmark.id < 1)
-    throw std::invalid_argument("QuadricMap::insertLandmark: id " + std::to_string(landmark.id) +
-                                " must be >= 1");
+    throw std::invalid_argument("LandmarkRegistry::insertLandmark: id " +
+                                std::to_string(landmark.id) + " must be >= 1");
   if (landmarks_.count(landmark.id) != 0)
-    throw std::invalid_argument("QuadricMap::insertLandmark: id " + std::to_string(landmark.id) +
-                                " is already in use");
+    throw std::invalid_argument("LandmarkRegistry::insertLandmark: id " +
+                                std::to_string(landmark.id) + " is already in use");
   const int k = minimalDimension(landmark.quadric_map.quadricClass());
   if (landmark.covariance.size() != 0 &&
       (landmark.covariance.rows() != k || landmark.covariance.cols() != k))
-    throw std::invalid_argument("QuadricMap::insertLandmark: landmark " +
+    throw std::invalid_argument("LandmarkRegistry::insertLandmark: landmark " +
                                 std::to_string(landmark.id) + ": covariance is not " +
                                 std::to_string(k) + "x" + std::to_string(k) + " for a " +
                                 toString(landmark.quadric_map.quadricClass()));
@@ -201,7 +202,7 @@ void QuadricMap::insertLandmark(const QuadricLandmark& landmark) {
   next_landmark_id_ = std::max(next_landmark_id_, landmark.id + 1);
 }
 
-void QuadricMap::clear() {
+void LandmarkRegistry::clear() {
   landmarks_.clear();
   candidates_.clear();
 }

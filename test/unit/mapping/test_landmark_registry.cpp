@@ -1,10 +1,10 @@
-// QuadricMap: a surface becomes a landmark only after min_observations (5) frames, a detection seen
-// 1-4 times never does and expires, ids are fresh, stable and never reused.
+// LandmarkRegistry: a surface becomes a landmark only after min_observations (5) frames, a
+// detection seen 1-4 times never does and expires, ids are fresh, stable and never reused.
 #include <gtest/gtest.h>
 
 #include <random>
 
-#include "quadric_slam/mapping/quadric_map.h"
+#include "quadric_slam/mapping/landmark_registry.h"
 #include "synthetic_world.h"
 
 namespace quadric_slam {
@@ -13,11 +13,11 @@ namespace {
 const Eigen::Isometry3d kCamera =
     test::lookAlong(Eigen::Vector3d(-2.0, 0.0, 1.0), Eigen::Vector3d(1.0, 0.0, -0.4));
 
-TEST(QuadricMap, ParamsValidate) {
-  QuadricMap::Params p;
+TEST(LandmarkRegistry, ParamsValidate) {
+  LandmarkRegistry::Params p;
   EXPECT_NO_THROW(p.validate());
   p.min_observations = 0;
-  EXPECT_THROW(QuadricMap{p}, std::invalid_argument);
+  EXPECT_THROW(LandmarkRegistry{p}, std::invalid_argument);
   p = {};
   p.candidate_timeout_frames = 0;
   EXPECT_THROW(p.validate(), std::invalid_argument);
@@ -26,8 +26,8 @@ TEST(QuadricMap, ParamsValidate) {
   EXPECT_THROW(p.validate(), std::invalid_argument);
 }
 
-TEST(QuadricMap, LandmarkOnlyAfterFiveObservations) {
-  QuadricMap map;
+TEST(LandmarkRegistry, LandmarkOnlyAfterFiveObservations) {
+  LandmarkRegistry map;
   std::mt19937 rng(21);
   const test::TrueLandmark sphere = test::sphere(Eigen::Vector3d(0, 0, 0.3), 0.25);
   const test::TrueLandmark cone =
@@ -77,11 +77,11 @@ TEST(QuadricMap, LandmarkOnlyAfterFiveObservations) {
 
 // A spurious detection seen 1..4 times (with gaps shorter than the timeout) never becomes a
 // landmark, and expires once unseen for longer than candidate_timeout_frames.
-TEST(QuadricMap, DetectionSeenFewerThanFiveTimesNeverEntersAndExpires) {
+TEST(LandmarkRegistry, DetectionSeenFewerThanFiveTimesNeverEntersAndExpires) {
   for (int times = 1; times <= 4; ++times) {
-    QuadricMap::Params p;
+    LandmarkRegistry::Params p;
     p.candidate_timeout_frames = 3;
-    QuadricMap map(p);
+    LandmarkRegistry map(p);
     std::mt19937 rng(30 + times);
     const test::TrueLandmark cylinder =
         test::cylinder(Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d::UnitZ(), 0.1, 0.5);
@@ -107,8 +107,8 @@ TEST(QuadricMap, DetectionSeenFewerThanFiveTimesNeverEntersAndExpires) {
 }
 
 // Ids: fresh per promotion, stable for a landmark, never reused, also after clear().
-TEST(QuadricMap, IdsAreStableAndNeverReused) {
-  QuadricMap map;
+TEST(LandmarkRegistry, IdsAreStableAndNeverReused) {
+  LandmarkRegistry map;
   std::mt19937 rng(40);
   const test::TrueLandmark a = test::sphere(Eigen::Vector3d(0, -0.5, 0.3), 0.2);
   const test::TrueLandmark b = test::sphere(Eigen::Vector3d(0, 0.5, 0.3), 0.2);

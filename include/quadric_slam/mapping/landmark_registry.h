@@ -5,6 +5,7 @@
 // frames becomes a landmark with a fresh id (landmark ids are never reused); a candidate not seen
 // for candidate_timeout_frames frames expires, so spurious one-off detections never reach the map.
 // Landmark estimates are refined elsewhere (mapping/window.h); here they are created and counted.
+// (The map as published is the message quadric_slam/QuadricMap, ros/map_publisher.h.)
 #pragma once
 
 #include <Eigen/Core>
@@ -12,9 +13,9 @@
 #include <map>
 #include <vector>
 
-#include "quadric_slam/types/observation.h"
 #include "quadric_slam/mapping/association.h"
 #include "quadric_slam/mapping/landmark.h"
+#include "quadric_slam/types/observation.h"
 
 namespace quadric_slam {
 
@@ -59,7 +60,7 @@ struct MapUpdate {
   int expired_candidates = 0;
 };
 
-class QuadricMap {
+class LandmarkRegistry {
  public:
   struct Params {
     // Frames a candidate must be seen in before it becomes a landmark (the paper's 5), [1, 1000].
@@ -72,8 +73,8 @@ class QuadricMap {
     void validate() const;
   };
 
-  QuadricMap() : QuadricMap(Params{}) {}
-  explicit QuadricMap(const Params& params);
+  LandmarkRegistry() : LandmarkRegistry(Params{}) {}
+  explicit LandmarkRegistry(const Params& params);
 
   // Associates a frame's (valid) measurements at the predicted pose T_map_camera with prediction
   // covariance pose_covariance (6x6, body tangent), updates counts, stamps and extents, starts,
