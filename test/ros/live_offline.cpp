@@ -25,6 +25,7 @@
 #include <string>
 
 #include "frame_player.h"
+#include "path_trajectory.h"
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/io/trajectory_io.h"
 #include "quadric_slam/ros/conversions.h"
@@ -150,8 +151,8 @@ TEST_F(LiveOfflineTest, TheNodeletsAndQuadricSlamGiveTheSameMapAndTrajectories) 
         << "no path for frame " << i;
   }
   spinUntil([&] { return false; }, 0.5);  // the last odometry
-  for (const geometry_msgs::PoseStamped& pose : path->poses)
-    live.T_map_camera[roundedStamp(pose.header.stamp.toSec())] = qs::fromPoseMsg(pose.pose);
+  for (const qs::StampedPose& pose : qs::test::toTrajectory(*path))
+    live.T_map_camera[roundedStamp(pose.stamp)] = pose.T_world_sensor;
   quadric_slam::SaveMap save;
   save.request.path = (dir_ / "live" / "map.yaml").string();
   ASSERT_TRUE(ros::service::waitForService("mapping/save_map", ros::Duration(10.0)));

@@ -34,6 +34,7 @@
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/ros/conversions.h"
 #include "frame_player.h"
+#include "path_trajectory.h"
 #include "quadric_slam/ros/markers.h"
 #include "quadric_slam/sim/surfaces.h"
 #include "synthetic_bag.h"
@@ -41,19 +42,13 @@
 namespace qs = quadric_slam;
 namespace fs = std::filesystem;
 using qs::test::spinUntil;
+using qs::test::toTrajectory;
 
 namespace {
 
 constexpr double kSeconds = 4.0;  // 40 frames at 10 Hz: the camera moves ~0.5 m
 constexpr double kRate = 10.0;
 constexpr std::size_t kReplayFrames = 12;  // played again against the loaded map
-
-qs::Trajectory toTrajectory(const nav_msgs::Path& path) {
-  qs::Trajectory out;
-  for (const geometry_msgs::PoseStamped& pose : path.poses)
-    out.push_back({pose.header.stamp.toSec(), qs::fromPoseMsg(pose.pose)});
-  return out;
-}
 
 qs::MapFile toMapFile(const quadric_slam::QuadricMap& map) {
   std::vector<qs::QuadricLandmark> landmarks;

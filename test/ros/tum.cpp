@@ -18,6 +18,7 @@
 #include <set>
 
 #include "frame_player.h"
+#include "path_trajectory.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
 #include "quadric_slam/io/trajectory_io.h"
 #include "quadric_slam/ros/conversions.h"
@@ -25,6 +26,7 @@
 
 namespace qs = quadric_slam;
 using qs::test::spinUntil;
+using qs::test::toTrajectory;
 
 namespace {
 
@@ -32,13 +34,6 @@ namespace {
 // pipeline falls behind the player (queues of 2); tum.test plays at a fifth of real time so that
 // a loaded 2-core machine keeps up.
 constexpr double kMinFrameShare = 0.9;
-
-qs::Trajectory toTrajectory(const nav_msgs::Path& path) {
-  qs::Trajectory out;
-  for (const geometry_msgs::PoseStamped& pose : path.poses)
-    out.push_back({pose.header.stamp.toSec(), qs::fromPoseMsg(pose.pose)});
-  return out;
-}
 
 TEST(TumLaunch, PlaysTheBagIntoAMapThatFollowsTheTruth) {
   ros::NodeHandle nh, private_nh("~");
