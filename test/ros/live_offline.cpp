@@ -10,12 +10,13 @@
 //
 // The frames are published one at a time, each after the mapper's path has reached the previous
 // one, so that the comparison is about the computation and not about frames dropped by a loaded
+// machine.
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
-#include <quadric_slam/SaveMap.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/point_types.h>
+#include <quadric_slam/SaveMap.h>
 #include <ros/ros.h>
 
 #include <cmath>

@@ -28,13 +28,13 @@
 #include <memory>
 #include <set>
 
+#include "frame_player.h"
+#include "path_trajectory.h"
 #include "quadric_slam/eval/map_metrics.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
 #include "quadric_slam/io/landmark_map_file.h"
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/ros/conversions.h"
-#include "frame_player.h"
-#include "path_trajectory.h"
 #include "quadric_slam/ros/markers.h"
 #include "quadric_slam/sim/surfaces.h"
 #include "synthetic_bag.h"
