@@ -14,8 +14,6 @@
 #include <quadric_slam/QuadricObservationArray.h>
 #include <quadric_slam/SaveMap.h>
 #include <ros/ros.h>
-#include <rosbag/bag.h>
-#include <rosbag/view.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -30,34 +28,27 @@
 #include <memory>
 #include <set>
 
+#include "frame_player.h"
+#include "path_trajectory.h"
 #include "quadric_slam/eval/map_metrics.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
 #include "quadric_slam/io/landmark_map_file.h"
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/markers.h"
-#include "quadric_slam/ros/tum_bag_writer.h"
-#include "quadric_slam/sim/renderer.h"
-#include "quadric_slam/sim/scene_yaml.h"
-#include "quadric_slam/sim/sequence_generator.h"
 #include "quadric_slam/sim/surfaces.h"
-#include "quadric_slam/sim/trajectory.h"
+#include "synthetic_bag.h"
 
 namespace qs = quadric_slam;
 namespace fs = std::filesystem;
+using qs::test::spinUntil;
+using qs::test::toTrajectory;
 
 namespace {
 
 constexpr double kSeconds = 4.0;  // 40 frames at 10 Hz: the camera moves ~0.5 m
 constexpr double kRate = 10.0;
 constexpr std::size_t kReplayFrames = 12;  // played again against the loaded map
-
-qs::Trajectory toTrajectory(const nav_msgs::Path& path) {
-  qs::Trajectory out;
-  for (const geometry_msgs::PoseStamped& pose : path.poses)
-    out.push_back({pose.header.stamp.toSec(), qs::fromPoseMsg(pose.pose)});
-  return out;
-}
 
 qs::MapFile toMapFile(const quadric_slam::QuadricMap& map) {
   std::vector<qs::QuadricLandmark> landmarks;
@@ -73,41 +64,14 @@ class MappingTest : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     bag_path_ = (dir_ / "desk.bag").string();
-    scene_ = qs::readSceneYaml(std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/desk.yaml");
-    truth_ = qs::HandheldTrajectory(scene_.handheld)
-                 .generate(scene_.centre_of_interest, kRate, kSeconds, 2);
-    const qs::Renderer renderer(qs::buildSurfaces(scene_), scene_.camera, scene_.depth, {},
-                                scene_.background);
-    qs::TumBagWriter bag(bag_path_, scene_.camera, {});
-    qs::SequenceGenerator(renderer, {})
-        .run(
-            truth_, [](std::size_t, const qs::StampedPose&, const qs::RenderedFrame&) {},
-            [&](std::size_t, const qs::StampedPose& pose, const qs::RenderedFrame& frame) {
-              bag.write(pose, frame);
-            });
-    bag.close();
-
-    rosbag::Bag reader(bag_path_, rosbag::bagmode::Read);
-    rosbag::View view(reader, rosbag::TopicQuery(std::vector<std::string>{
-                                  "/camera/depth/image", "/camera/depth/camera_info"}));
-    for (const rosbag::MessageInstance& m : view) {
-      if (auto info = m.instantiate<sensor_msgs::CameraInfo>())
-        info_ = info;
-      else if (auto depth = m.instantiate<sensor_msgs::Image>())
-        depths_.push_back(depth);
-    }
+    const qs::test::SyntheticBag bag = qs::test::writeDeskBag(bag_path_, kRate, kSeconds, 2);
+    scene_ = bag.scene;
+    truth_ = bag.truth;
+    qs::test::BagDepthFrames frames = qs::test::readBagDepthFrames(bag_path_);
+    info_ = frames.info;
+    depths_ = std::move(frames.depths);
   }
   void TearDown() override { fs::remove_all(dir_); }
-
-  // Spins until done() or the timeout; returns done().
-  static bool spinUntil(const std::function<bool()>& done, double timeout_s) {
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout_s);
-    while (!done() && ros::WallTime::now() < deadline) {
-      ros::WallDuration(0.005).sleep();
-      ros::spinOnce();
-    }
-    return done();
-  }
 
   fs::path dir_;
   std::string bag_path_;
@@ -121,9 +85,7 @@ TEST_F(MappingTest, MapsTheDeskSavesLoadsAndLocalises) {
   ASSERT_TRUE(info_);
   ASSERT_EQ(depths_.size(), truth_.size());
   ros::NodeHandle nh;
-  ros::Publisher depth_pub = nh.advertise<sensor_msgs::Image>("/camera/depth/image", 2);
-  ros::Publisher info_pub =
-      nh.advertise<sensor_msgs::CameraInfo>("/camera/depth/camera_info", 2, true);
+  qs::test::FramePlayer player(nh);
   quadric_slam::QuadricMapConstPtr map;
   visualization_msgs::MarkerArrayConstPtr markers;
   sensor_msgs::PointCloud2ConstPtr reconstruction;
@@ -165,13 +127,12 @@ TEST_F(MappingTest, MapsTheDeskSavesLoadsAndLocalises) {
   // One connection per subscribing process: all nodelets share the manager's.
   ASSERT_TRUE(spinUntil(
       [&] {
-        return depth_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0 &&
-               path_sub.getNumPublishers() > 0 && map_sub.getNumPublishers() > 0 &&
+        return path_sub.getNumPublishers() > 0 && map_sub.getNumPublishers() > 0 &&
                odom_sub.getNumPublishers() > 0 && reconstruction_sub.getNumPublishers() > 0;
       },
       60.0))
       << "the pipeline did not come up";
-  info_pub.publish(info_);
+  ASSERT_TRUE(player.waitForSubscribers(10.0)) << "the pipeline does not subscribe";
   ASSERT_TRUE(spinUntil([&] { return map != nullptr; }, 10.0)) << "no latched map at start";
   EXPECT_TRUE(map->quadrics.empty());
 
@@ -180,12 +141,8 @@ TEST_F(MappingTest, MapsTheDeskSavesLoadsAndLocalises) {
   // camera_info to the nodelets (the nodelet drops it by design) and is sent again.
   auto play = [&](const sensor_msgs::ImageConstPtr& depth, int attempts) {
     const ros::Time stamp = depth->header.stamp;
-    for (int attempt = 0; attempt < attempts; ++attempt) {
-      info_pub.publish(info_);
-      depth_pub.publish(depth);
-      if (spinUntil([&] { return path && path->header.stamp == stamp; }, 20.0))
-        return true;
-    }
+    if (player.play(depth, info_, [&] { return path && path->header.stamp == stamp; }, attempts))
+      return true;
     std::printf("mapping: frame %.3f: odom %s, observations %s, path at %.3f; diagnostics: %s\n",
                 stamp.toSec(), odoms.count(stamp.toSec()) ? "yes" : "no",
                 observation_stamps.count(stamp.toSec()) ? "yes" : "no",

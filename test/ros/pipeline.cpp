@@ -18,37 +18,20 @@
 #include <set>
 
 #include "quadric_slam/eval/trajectory_metrics.h"
-#include "quadric_slam/sim/scene_yaml.h"
-#include "quadric_slam/ros/tum_bag_writer.h"
-#include "quadric_slam/sim/renderer.h"
-#include "quadric_slam/sim/sequence_generator.h"
-#include "quadric_slam/sim/surfaces.h"
-#include "quadric_slam/sim/trajectory.h"
+#include "synthetic_bag.h"
 
 namespace qs = quadric_slam;
 
 namespace {
 
 constexpr double kSeconds = 1.5;  // 45 frames at 30 Hz
+constexpr double kRate = 30.0;    // the desk scene's camera rate
 
 class PipelineTest : public ::testing::Test {
  protected:
   void SetUp() override {
     bag_path_ = testing::TempDir() + "/pipeline_test.bag";
-    const qs::Scene scene =
-        qs::readSceneYaml(std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/desk.yaml");
-    truth_ = qs::HandheldTrajectory(scene.handheld)
-                 .generate(scene.centre_of_interest, scene.rate, kSeconds, 7);
-    const qs::Renderer renderer(qs::buildSurfaces(scene), scene.camera, scene.depth, {},
-                                scene.background);
-    qs::TumBagWriter bag(bag_path_, scene.camera, {});
-    qs::SequenceGenerator(renderer, {})
-        .run(
-            truth_, [](std::size_t, const qs::StampedPose&, const qs::RenderedFrame&) {},
-            [&](std::size_t, const qs::StampedPose& pose, const qs::RenderedFrame& frame) {
-              bag.write(pose, frame);
-            });
-    bag.close();
+    truth_ = qs::test::writeDeskBag(bag_path_, kRate, kSeconds, 7).truth;
   }
   void TearDown() override { std::filesystem::remove(bag_path_); }
 
