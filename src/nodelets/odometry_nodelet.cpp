@@ -7,9 +7,10 @@
 //             a decimation of that image: the factor is cloud width vs camera_info width)
 // Publishes   odom (nav_msgs/Odometry: pose of ~camera_frame in ~odom_frame with covariance)
 //             tf ~odom_frame -> ~camera_frame (when ~publish_tf)
-//             /diagnostics (diagnostic_msgs/DiagnosticArray, at most once a second)
+//             /diagnostics (frames processed and dropped per reason, processing time, output
+//             rate: ros/diagnostics.h; and "<name> tracking": ok / degenerate / lost with the ICP
+//             figures of the last frame)
 // All parameters are documented in config/odometry.yaml.
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
@@ -21,16 +22,17 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <pluginlib/class_list_macros.hpp>
 
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <memory>
 #include <mutex>
-#include <sstream>
 #include <string>
 
 #include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
 #include "quadric_slam/ros/depth_image.h"
+#include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/params.h"
 #include "quadric_slam/ros/points_normals.h"
 
@@ -65,7 +67,8 @@ class OdometryNodelet : public nodelet::Nodelet {
 
     tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
     odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", queue_size);
-    diagnostics_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
+    diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, private_nh, getName());
+    diagnostics_->addTask("tracking", this, &OdometryNodelet::diagnoseTracking);
     info_sub_ = nh.subscribe("depth/camera_info", queue_size, &OdometryNodelet::onCameraInfo, this);
     cloud_sub_ = nh.subscribe("points_normals", queue_size, &OdometryNodelet::onCloud, this);
   }
@@ -83,14 +86,12 @@ class OdometryNodelet : public nodelet::Nodelet {
   }
 
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+    const auto start = std::chrono::steady_clock::now();
     CameraIntrinsics intrinsics;
     {
       std::lock_guard<std::mutex> lock(intrinsics_mutex_);
       if (!have_intrinsics_) {
-        NODELET_ERROR_THROTTLE(5.0,
-                               "odometry: no valid camera_info received on %s yet; dropping "
-                               "clouds",
-                               info_sub_.getTopic().c_str());
+        drop("no valid camera_info received on " + info_sub_.getTopic() + " yet");
         return;
       }
       intrinsics = intrinsics_;
@@ -98,13 +99,12 @@ class OdometryNodelet : public nodelet::Nodelet {
     std::string problem;
     if (organizedCloudDecimation(intrinsics, static_cast<int>(msg->width),
                                  static_cast<int>(msg->height), &problem) == 0) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", problem.c_str());
+      drop(problem);
       return;
     }
     problem = pointsNormalsFromMsg(*msg, cloud_);
     if (!problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud from %s: %s",
-                             cloud_sub_.getTopic().c_str(), problem.c_str());
+      drop("cloud from " + cloud_sub_.getTopic() + ": " + problem);
       return;
     }
 
@@ -124,19 +124,32 @@ class OdometryNodelet : public nodelet::Nodelet {
     try {
       result = tracker_->track(cloud_, intrinsics, stamp);
     } catch (const std::invalid_argument& e) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", e.what());
+      drop(e.what());
       return;
     }
-    ++frames_;
-    counts_[static_cast<int>(result.status)]++;
     if (result.status != TrackingStatus::kOk) {
       NODELET_WARN_THROTTLE(5.0, "odometry: tracking %s: %s", toString(result.status),
                             result.icp.message.c_str());
     }
-    publishDiagnostics(result, msg->header.stamp);
-    if (!tracker_->initialized())
-      return;  // no odom frame yet (no usable first frame)
+    {
+      std::lock_guard<std::mutex> lock(tracking_mutex_);
+      ++frames_;
+      counts_[static_cast<int>(result.status)]++;
+      last_result_ = result;
+    }
+    if (!tracker_->initialized()) {
+      drop("no odometry yet: the first frame was not usable");
+      return;
+    }
     publishOdometry(result, msg->header.stamp);
+    diagnostics_->frameProcessed(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
+  }
+
+  void drop(const std::string& reason) {
+    NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", reason.c_str());
+    diagnostics_->frameDropped(reason);
   }
 
   void publishOdometry(const OdometryTracker::Result& result, const ros::Time& stamp) {
@@ -190,49 +203,28 @@ class OdometryNodelet : public nodelet::Nodelet {
     }
   }
 
-  void publishDiagnostics(const OdometryTracker::Result& result, const ros::Time& stamp) {
-    const ros::WallTime now = ros::WallTime::now();
-    if (diagnostics_pub_.getNumSubscribers() == 0 || (now - last_diagnostics_).toSec() < 1.0)
-      return;
-    last_diagnostics_ = now;
-    diagnostic_msgs::DiagnosticArray array;
-    array.header.stamp = stamp;
-    diagnostic_msgs::DiagnosticStatus status;
-    status.name = getName() + ": tracking";
-    status.hardware_id = camera_frame_;
-    switch (result.status) {
-      case TrackingStatus::kOk:
-        status.level = diagnostic_msgs::DiagnosticStatus::OK;
-        status.message = "tracking";
-        break;
-      case TrackingStatus::kDegenerate:
-        status.level = diagnostic_msgs::DiagnosticStatus::WARN;
-        status.message = "degenerate geometry: " + result.icp.message;
-        break;
-      case TrackingStatus::kLost:
-        status.level = diagnostic_msgs::DiagnosticStatus::ERROR;
-        status.message = "lost: " + result.icp.message;
-        break;
-    }
-    const auto add = [&status](const std::string& key, const auto& value) {
-      diagnostic_msgs::KeyValue kv;
-      kv.key = key;
-      std::ostringstream text;
-      text << value;
-      kv.value = text.str();
-      status.values.push_back(kv);
-    };
-    add("frames", frames_);
-    add("ok", counts_[0]);
-    add("degenerate", counts_[1]);
-    add("lost", counts_[2]);
-    add("consecutive lost", result.consecutive_lost);
-    add("correspondences", result.icp.correspondences);
-    add("inlier fraction", result.icp.inlier_fraction);
-    add("rms residual (m at 1 m)", result.icp.rms_residual);
-    add("iterations", result.icp.iterations);
-    array.status.push_back(status);
-    diagnostics_pub_.publish(array);
+  // The tracking state of the last frame, with the counts per state since the start.
+  void diagnoseTracking(diagnostic_updater::DiagnosticStatusWrapper& status) {
+    std::lock_guard<std::mutex> lock(tracking_mutex_);
+    const OdometryTracker::Result& result = last_result_;
+    using diagnostic_msgs::DiagnosticStatus;
+    if (frames_ == 0)
+      status.summary(DiagnosticStatus::OK, "waiting for input");
+    else if (result.status == TrackingStatus::kOk)
+      status.summary(DiagnosticStatus::OK, "tracking");
+    else if (result.status == TrackingStatus::kDegenerate)
+      status.summary(DiagnosticStatus::WARN, "degenerate geometry: " + result.icp.message);
+    else
+      status.summary(DiagnosticStatus::ERROR, "lost: " + result.icp.message);
+    status.add("frames", frames_);
+    status.add("ok", counts_[0]);
+    status.add("degenerate", counts_[1]);
+    status.add("lost", counts_[2]);
+    status.add("consecutive lost", result.consecutive_lost);
+    status.add("correspondences", result.icp.correspondences);
+    status.add("inlier fraction", result.icp.inlier_fraction);
+    status.add("rms residual (m at 1 m)", result.icp.rms_residual);
+    status.add("iterations", result.icp.iterations);
   }
 
   std::string odom_frame_ = "odom";
@@ -248,11 +240,13 @@ class OdometryNodelet : public nodelet::Nodelet {
   bool last_pose_valid_ = false;
   Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
   ros::Time last_pose_stamp_;
+  std::mutex tracking_mutex_;  // the tracking figures, read by the diagnostics thread
   long frames_ = 0;
   long counts_[3] = {0, 0, 0};
-  ros::WallTime last_diagnostics_;
+  OdometryTracker::Result last_result_;
+  std::unique_ptr<NodeletDiagnostics> diagnostics_;
   ros::Subscriber cloud_sub_, info_sub_;
-  ros::Publisher odom_pub_, diagnostics_pub_;
+  ros::Publisher odom_pub_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
 };
 
