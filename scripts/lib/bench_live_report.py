@@ -51,6 +51,7 @@ def main():
 
     with rosbag.Bag(args.bag) as bag:
         bag_frames = bag.get_message_count(args.depth_topic)
+        bag_seconds = bag.get_end_time() - bag.get_start_time()
     with open(args.diagnostics) as f:
         statuses = yaml.safe_load(f) or {}  # collect_diagnostics' file
     with open(args.timing) as f:
@@ -93,6 +94,14 @@ def main():
     if offline_frames is not None:
         lines.append("offline: %s frames in %.1f s wall" % (offline_frames,
                                                               timing.get("wall_s", 0.0)))
+    # What keeping up costs: every stage's offline median per frame, at the bag's frame rate, in
+    # cores (the stages run in parallel in the manager, but each frame needs all of them).
+    per_frame_ms = sum(stages[s]["median_ms"] for _, _, names in NODELETS for s in names
+                       if s in stages)
+    if bag_seconds > 0 and per_frame_ms > 0:
+        rate_hz = bag_frames / bag_seconds
+        lines.append("CPU to keep up: %.0f ms per frame (sum of the offline medians) x %.1f Hz "
+                     "= %.2f cores busy" % (per_frame_ms, rate_hz, per_frame_ms * rate_hz / 1e3))
     lines.append("")
     lines.append("result: " + ("PASS (every nodelet >= %.0f %% of the bag's frames)" %
                                (100 * args.min_share) if not failures else
