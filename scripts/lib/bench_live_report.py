@@ -11,6 +11,7 @@ Prints the report and writes it (Markdown) to --out. Exits 1 when a nodelet proc
 """
 import argparse
 import json
+import os
 import sys
 
 import rosbag
@@ -45,6 +46,7 @@ def main():
     parser.add_argument("--depth-topic", default="/camera/depth/image")
     parser.add_argument("--timing", required=True)
     parser.add_argument("--header", default="")
+    parser.add_argument("--rate", type=float, default=1.0, help="the playback rate")
     parser.add_argument("--min-share", type=float, default=0.95)
     parser.add_argument("--out", required=True)
     args = parser.parse_args()
@@ -94,14 +96,15 @@ def main():
     if offline_frames is not None:
         lines.append("offline: %s frames in %.1f s wall" % (offline_frames,
                                                               timing.get("wall_s", 0.0)))
-    # What keeping up costs: every stage's offline median per frame, at the bag's frame rate, in
+    # What keeping up costs: every stage's offline median per frame, at the played frame rate, in
     # cores (the stages run in parallel in the manager, but each frame needs all of them).
     per_frame_ms = sum(stages[s]["median_ms"] for _, _, names in NODELETS for s in names
                        if s in stages)
     if bag_seconds > 0 and per_frame_ms > 0:
-        rate_hz = bag_frames / bag_seconds
+        rate_hz = args.rate * bag_frames / bag_seconds
         lines.append("CPU to keep up: %.0f ms per frame (sum of the offline medians) x %.1f Hz "
-                     "= %.2f cores busy" % (per_frame_ms, rate_hz, per_frame_ms * rate_hz / 1e3))
+                     "= %.2f cores busy (this machine: %d, shared)" % (
+                         per_frame_ms, rate_hz, per_frame_ms * rate_hz / 1e3, os.cpu_count()))
     lines.append("")
     lines.append("result: " + ("PASS (every nodelet >= %.0f %% of the bag's frames)" %
                                (100 * args.min_share) if not failures else
