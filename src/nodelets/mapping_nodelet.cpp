@@ -15,7 +15,8 @@
 //             path (nav_msgs/Path of T_map_camera per frame in ~map_frame, at most ~max_path_poses)
 //             tf ~map_frame -> ~odom_frame (T_map_odom, REP-105; when ~publish_tf)
 //             /diagnostics (landmarks per class, window, solve time, associations, frames
-//             processed and dropped, every ~diagnostic_period)
+//             processed and dropped, processing time median / p95 of the latest frames, every
+//             ~diagnostic_period)
 // Services    ~save_map (quadric_slam/SaveMap): map YAML + reconstruction PCD beside it
 //             ~load_map (quadric_slam/LoadMap): start from a saved map, optionally localisation
 //             only
@@ -58,7 +59,9 @@
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
+#include "quadric_slam/eval/recent_durations.h"
 #include "quadric_slam/ros/conversions.h"
+#include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/map_files.h"
 #include "quadric_slam/ros/map_publisher.h"
@@ -363,8 +366,8 @@ class MappingNodelet : public nodelet::Nodelet {
       stats_.window = result.window;
       stats_.solve_ms = 1e3 * result.optimisation_seconds;
     }
-    stats_.processing_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    stats_.processing_times.add(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
   }
 
   // The observations are used in the frame whose pose odom gives (its child frame). Another frame
@@ -572,7 +575,8 @@ class MappingNodelet : public nodelet::Nodelet {
     std::string last_drop_reason, last_observation_problem;
     FrameStats last;
     WindowStatistics window;
-    double solve_ms = 0.0, association_ms = 0.0, processing_ms = 0.0;
+    double solve_ms = 0.0, association_ms = 0.0;
+    RecentDurations processing_times{300};  // of processed frames, the latest 300
     std::map<std::string, int> landmarks_per_class;
     int landmarks = 0, candidates = 0;
     std::string observation_frame, camera_frame;  // of the latest frame (observations, odom child)
@@ -633,6 +637,7 @@ class MappingNodelet : public nodelet::Nodelet {
     for (const auto& [name, count] : s.landmarks_per_class)
       status.add("landmarks: " + name, count);
     status.add("candidates", s.candidates);
+    status.add("frames received", s.synchronised);
     status.add("frames processed", s.frames_processed);
     status.add("frames dropped", s.frames_dropped);
     status.add("last drop reason", s.last_drop_reason);
@@ -659,7 +664,7 @@ class MappingNodelet : public nodelet::Nodelet {
     status.add("window final cost", s.window.final_cost);
     status.add("solve time (ms, last keyframe)", s.solve_ms);
     status.add("association time (ms, last frame)", s.association_ms);
-    status.add("processing time (ms, last frame)", s.processing_ms);
+    addTimingValues(status, s.processing_times.summary());
   }
 
   // Parameters.

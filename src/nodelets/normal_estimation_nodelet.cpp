@@ -6,7 +6,8 @@
 // Publishes   points_normals (sensor_msgs/PointCloud2, organized, fields x y z normal_x normal_y
 //             normal_z curvature, NaN where there is no data, the depth image's stamp; frame
 //             ~output_frame, or the image's frame id when that is empty, without a leading '/')
-//             /diagnostics (health: frames processed and dropped, last reason)
+//             /diagnostics (frames processed and dropped per reason, processing time, output
+//             rate: ros/diagnostics.h)
 // Bad input (no camera_info yet, unsupported encoding, size mismatch, malformed buffer) gets a
 // throttled error and the frame is dropped.
 #include <nodelet/nodelet.h>
@@ -50,7 +51,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     }
     NODELET_INFO("normal_estimation parameters:%s", log.str().c_str());
 
-    diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, "quadric_slam: normal_estimation");
+    diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, private_nh, getName());
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("points_normals", queue_size);
     info_sub_ =
         nh.subscribe("depth/camera_info", queue_size, &NormalEstimationNodelet::onCameraInfo, this);

@@ -11,11 +11,12 @@
 //             offline runner)
 // Publishes   odom (nav_msgs/Odometry: pose of ~camera_frame in ~odom_frame with covariance)
 //             tf ~odom_frame -> ~camera_frame (when ~publish_tf)
-//             /diagnostics (diagnostic_msgs/DiagnosticArray, at most once a second)
+//             /diagnostics (frames processed and dropped per reason, processing time, output
+//             rate: ros/diagnostics.h; and "<name> tracking": ok / degenerate / lost with the ICP
+//             figures of the last frame)
 // All parameters are documented in config/odometry.yaml. The cloud's own frame id is not used: the
 // pose is that of ~camera_frame, our name for the tracked optical frame (normal_estimation's
 // ~output_frame gives the clouds the same name in quadric_slam.launch).
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
@@ -29,11 +30,11 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <pluginlib/class_list_macros.hpp>
 
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <memory>
 #include <mutex>
-#include <sstream>
 #include <string>
 
 #include "quadric_slam/QuadricObservationArray.h"
@@ -41,6 +42,7 @@
 #include "quadric_slam/odometry/odometry_tracker.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/depth_image.h"
+#include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/params.h"
 #include "quadric_slam/ros/points_normals.h"
@@ -77,7 +79,8 @@ class OdometryNodelet : public nodelet::Nodelet {
 
     tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
     odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", queue_size);
-    diagnostics_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
+    diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, private_nh, getName());
+    diagnostics_->addTask("tracking", this, &OdometryNodelet::diagnoseTracking);
     info_sub_ = nh.subscribe("depth/camera_info", queue_size, &OdometryNodelet::onCameraInfo, this);
     if (use_observations_) {
       cloud_filter_.subscribe(nh, "points_normals", queue_size);
@@ -119,14 +122,12 @@ class OdometryNodelet : public nodelet::Nodelet {
 
   void track(const sensor_msgs::PointCloud2ConstPtr& msg,
              const std::vector<QuadricMeasurement>* observations) {
+    const auto start = std::chrono::steady_clock::now();
     CameraIntrinsics intrinsics;
     {
       std::lock_guard<std::mutex> lock(intrinsics_mutex_);
       if (!have_intrinsics_) {
-        NODELET_ERROR_THROTTLE(5.0,
-                               "odometry: no valid camera_info received on %s yet; dropping "
-                               "clouds",
-                               info_sub_.getTopic().c_str());
+        drop("no valid camera_info received on " + info_sub_.getTopic() + " yet");
         return;
       }
       intrinsics = intrinsics_;
@@ -134,12 +135,12 @@ class OdometryNodelet : public nodelet::Nodelet {
     std::string problem;
     if (organizedCloudDecimation(intrinsics, static_cast<int>(msg->width),
                                  static_cast<int>(msg->height), &problem) == 0) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", problem.c_str());
+      drop(problem);
       return;
     }
     problem = pointsNormalsFromMsg(*msg, cloud_);
     if (!problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping points_normals cloud: %s", problem.c_str());
+      drop("points_normals cloud: " + problem);
       return;
     }
 
@@ -159,19 +160,32 @@ class OdometryNodelet : public nodelet::Nodelet {
     try {
       result = tracker_->track(cloud_, intrinsics, stamp, observations);
     } catch (const std::invalid_argument& e) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", e.what());
+      drop(e.what());
       return;
     }
-    ++frames_;
-    counts_[static_cast<int>(result.status)]++;
     if (result.status != TrackingStatus::kOk) {
       NODELET_WARN_THROTTLE(5.0, "odometry: tracking %s: %s", toString(result.status),
                             result.icp.message.c_str());
     }
-    publishDiagnostics(result, msg->header.stamp);
-    if (!tracker_->initialized())
-      return;  // no odom frame yet (no usable first frame)
+    {
+      std::lock_guard<std::mutex> lock(tracking_mutex_);
+      ++frames_;
+      counts_[static_cast<int>(result.status)]++;
+      last_result_ = result;
+    }
+    if (!tracker_->initialized()) {
+      drop("no odometry yet: the first frame was not usable");
+      return;
+    }
     publishOdometry(result, msg->header.stamp);
+    diagnostics_->frameProcessed(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
+  }
+
+  void drop(const std::string& reason) {
+    NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", reason.c_str());
+    diagnostics_->frameDropped(reason);
   }
 
   void publishOdometry(const OdometryTracker::Result& result, const ros::Time& stamp) {
@@ -225,49 +239,28 @@ class OdometryNodelet : public nodelet::Nodelet {
     }
   }
 
-  void publishDiagnostics(const OdometryTracker::Result& result, const ros::Time& stamp) {
-    const ros::WallTime now = ros::WallTime::now();
-    if (diagnostics_pub_.getNumSubscribers() == 0 || (now - last_diagnostics_).toSec() < 1.0)
-      return;
-    last_diagnostics_ = now;
-    diagnostic_msgs::DiagnosticArray array;
-    array.header.stamp = stamp;
-    diagnostic_msgs::DiagnosticStatus status;
-    status.name = getName() + ": tracking";
-    status.hardware_id = camera_frame_;
-    switch (result.status) {
-      case TrackingStatus::kOk:
-        status.level = diagnostic_msgs::DiagnosticStatus::OK;
-        status.message = "tracking";
-        break;
-      case TrackingStatus::kDegenerate:
-        status.level = diagnostic_msgs::DiagnosticStatus::WARN;
-        status.message = "degenerate geometry: " + result.icp.message;
-        break;
-      case TrackingStatus::kLost:
-        status.level = diagnostic_msgs::DiagnosticStatus::ERROR;
-        status.message = "lost: " + result.icp.message;
-        break;
-    }
-    const auto add = [&status](const std::string& key, const auto& value) {
-      diagnostic_msgs::KeyValue kv;
-      kv.key = key;
-      std::ostringstream text;
-      text << value;
-      kv.value = text.str();
-      status.values.push_back(kv);
-    };
-    add("frames", frames_);
-    add("ok", counts_[0]);
-    add("degenerate", counts_[1]);
-    add("lost", counts_[2]);
-    add("consecutive lost", result.consecutive_lost);
-    add("correspondences", result.icp.correspondences);
-    add("inlier fraction", result.icp.inlier_fraction);
-    add("rms residual (m at 1 m)", result.icp.rms_residual);
-    add("iterations", result.icp.iterations);
-    array.status.push_back(status);
-    diagnostics_pub_.publish(array);
+  // The tracking state of the last frame, with the counts per state since the start.
+  void diagnoseTracking(diagnostic_updater::DiagnosticStatusWrapper& status) {
+    std::lock_guard<std::mutex> lock(tracking_mutex_);
+    const OdometryTracker::Result& result = last_result_;
+    using diagnostic_msgs::DiagnosticStatus;
+    if (frames_ == 0)
+      status.summary(DiagnosticStatus::OK, "waiting for input");
+    else if (result.status == TrackingStatus::kOk)
+      status.summary(DiagnosticStatus::OK, "tracking");
+    else if (result.status == TrackingStatus::kDegenerate)
+      status.summary(DiagnosticStatus::WARN, "degenerate geometry: " + result.icp.message);
+    else
+      status.summary(DiagnosticStatus::ERROR, "lost: " + result.icp.message);
+    status.add("frames", frames_);
+    status.add("ok", counts_[0]);
+    status.add("degenerate", counts_[1]);
+    status.add("lost", counts_[2]);
+    status.add("consecutive lost", result.consecutive_lost);
+    status.add("correspondences", result.icp.correspondences);
+    status.add("inlier fraction", result.icp.inlier_fraction);
+    status.add("rms residual (m at 1 m)", result.icp.rms_residual);
+    status.add("iterations", result.icp.iterations);
   }
 
   std::string odom_frame_ = "odom";
@@ -283,9 +276,11 @@ class OdometryNodelet : public nodelet::Nodelet {
   bool last_pose_valid_ = false;
   Eigen::Isometry3d last_pose_ = Eigen::Isometry3d::Identity();
   ros::Time last_pose_stamp_;
+  std::mutex tracking_mutex_;  // the tracking figures, read by the diagnostics thread
   long frames_ = 0;
   long counts_[3] = {0, 0, 0};
-  ros::WallTime last_diagnostics_;
+  OdometryTracker::Result last_result_;
+  std::unique_ptr<NodeletDiagnostics> diagnostics_;
   bool use_observations_ = false;
   ros::Subscriber cloud_sub_, info_sub_;
   using Synchronizer =
@@ -293,7 +288,7 @@ class OdometryNodelet : public nodelet::Nodelet {
   message_filters::Subscriber<sensor_msgs::PointCloud2> cloud_filter_;
   message_filters::Subscriber<QuadricObservationArray> observations_filter_;
   std::unique_ptr<Synchronizer> sync_;
-  ros::Publisher odom_pub_, diagnostics_pub_;
+  ros::Publisher odom_pub_;
   std::unique_ptr<tf2_ros::TransformBroadcaster> tf_broadcaster_;
 };
 

@@ -12,7 +12,8 @@
 //             while subscribed)
 //             ~segmented_cloud (sensor_msgs/PointCloud2 x y z label, organized, label 0 =
 //             unassigned; only computed while subscribed)
-//             /diagnostics (health: frames processed and dropped, last reason)
+//             /diagnostics (frames processed and dropped per reason, processing time, output
+//             rate: ros/diagnostics.h)
 // A cloud without normal fields or not organized gets a throttled error and is dropped.
 #include <nodelet/nodelet.h>
 #include <pcl_conversions/pcl_conversions.h>
@@ -86,7 +87,7 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
     }
     NODELET_INFO("quadric_segmentation parameters:%s", log.str().c_str());
 
-    diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, "quadric_slam: quadric_segmentation");
+    diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, private_nh, getName());
     observations_pub_ = nh.advertise<QuadricObservationArray>("observations", queue_size);
     image_pub_ = private_nh.advertise<sensor_msgs::Image>("segmentation_image", 1);
     cloud_pub_ = private_nh.advertise<sensor_msgs::PointCloud2>("segmented_cloud", 1);

@@ -1,72 +1,82 @@
 #include "quadric_slam/ros/diagnostics.h"
 
-#include <diagnostic_msgs/DiagnosticStatus.h>
-#include <diagnostic_msgs/KeyValue.h>
-
 namespace quadric_slam {
+
+void addTimingValues(diagnostic_updater::DiagnosticStatusWrapper& status,
+                     const TimingSummary& timing) {
+  status.add("processing time median (ms)", timing.median_ms);
+  status.add("processing time p95 (ms)", timing.p95_ms);
+  status.add("processing time max (ms)", timing.max_ms);
+  status.add("processing time window (frames)", timing.count);
+}
+
 namespace {
 
-diagnostic_msgs::KeyValue keyValue(const std::string& key, const std::string& value) {
-  diagnostic_msgs::KeyValue kv;
-  kv.key = key;
-  kv.value = value;
-  return kv;
+std::string withoutLeadingSlash(const std::string& name) {
+  return !name.empty() && name[0] == '/' ? name.substr(1) : name;
 }
 
 }  // namespace
 
-NodeletDiagnostics::NodeletDiagnostics(ros::NodeHandle& nh, const std::string& name,
-                                       double period_s)
-    : name_(name) {
-  publisher_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
-  timer_ = nh.createWallTimer(ros::WallDuration(period_s), &NodeletDiagnostics::publish, this);
+// The updater's "node name" is the prefix of every status: "quadric_slam: <nodelet name> ...",
+// one group in rqt_robot_monitor for all of the package's nodelets.
+NodeletDiagnostics::NodeletDiagnostics(ros::NodeHandle& nh, ros::NodeHandle& private_nh,
+                                       const std::string& nodelet_name, const Options& options)
+    : name_(withoutLeadingSlash(nodelet_name)),
+      min_rate_hz_(options.min_output_rate_hz),
+      max_rate_hz_(options.max_output_rate_hz),
+      updater_(nh, private_nh, "/quadric_slam"),
+      output_rate_(diagnostic_updater::FrequencyStatusParam(&min_rate_hz_, &max_rate_hz_),
+                   name_ + " output rate"),
+      frames_(options.timing_window) {
+  updater_.setHardwareID("quadric_slam");
+  updater_.add(name_, this, &NodeletDiagnostics::report);
+  updater_.add(output_rate_);
+  // A wall timer: on a bag's clock the reports go on while it is paused or has ended.
+  timer_ = nh.createWallTimer(ros::WallDuration(updater_.getPeriod()), &NodeletDiagnostics::onTimer,
+                              this);
 }
 
 void NodeletDiagnostics::frameProcessed(double processing_ms) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  ++processed_;
-  last_processing_ms_ = processing_ms;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    frames_.processed(processing_ms);
+  }
+  output_rate_.tick();
 }
 
 void NodeletDiagnostics::frameDropped(const std::string& reason) {
   std::lock_guard<std::mutex> lock(mutex_);
-  ++dropped_;
-  last_drop_reason_ = reason;
+  frames_.dropped(reason);
 }
 
-void NodeletDiagnostics::publish(const ros::WallTimerEvent&) {
-  diagnostic_msgs::DiagnosticStatus status;
-  status.name = name_;
-  status.hardware_id = "quadric_slam";
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    const unsigned long new_processed = processed_ - processed_at_last_report_;
-    const unsigned long new_dropped = dropped_ - dropped_at_last_report_;
-    processed_at_last_report_ = processed_;
-    dropped_at_last_report_ = dropped_;
-    if (new_dropped > 0 && new_processed == 0) {
-      status.level = diagnostic_msgs::DiagnosticStatus::ERROR;
-      status.message = "dropping every frame: " + last_drop_reason_;
-    } else if (new_dropped > 0) {
-      status.level = diagnostic_msgs::DiagnosticStatus::WARN;
-      status.message = "dropping some frames: " + last_drop_reason_;
-    } else if (new_processed == 0) {
-      status.level = diagnostic_msgs::DiagnosticStatus::OK;
-      status.message = "waiting for input";
-    } else {
-      status.level = diagnostic_msgs::DiagnosticStatus::OK;
-      status.message = "ok";
-    }
-    status.values.push_back(keyValue("frames processed", std::to_string(processed_)));
-    status.values.push_back(keyValue("frames dropped", std::to_string(dropped_)));
-    status.values.push_back(
-        keyValue("last processing time (ms)", std::to_string(last_processing_ms_)));
-    status.values.push_back(keyValue("last drop reason", last_drop_reason_));
+void NodeletDiagnostics::onTimer(const ros::WallTimerEvent&) {
+  try {
+    updater_.force_update();
+  } catch (const std::exception& e) {
+    ROS_ERROR_THROTTLE(30.0, "%s: diagnostics failed: %s", name_.c_str(), e.what());
   }
-  diagnostic_msgs::DiagnosticArray array;
-  array.header.stamp = ros::Time::now();
-  array.status.push_back(status);
-  publisher_.publish(array);
+}
+
+void NodeletDiagnostics::report(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const FrameStatistics::Period period = frames_.takePeriod();
+  using diagnostic_msgs::DiagnosticStatus;
+  if (period.dropped > 0 && period.processed == 0)
+    status.summary(DiagnosticStatus::ERROR, "dropping every frame: " + frames_.lastDropReason());
+  else if (period.dropped > 0)
+    status.summary(DiagnosticStatus::WARN, "dropping some frames: " + frames_.lastDropReason());
+  else if (period.processed == 0)
+    status.summary(DiagnosticStatus::OK, "waiting for input");
+  else
+    status.summary(DiagnosticStatus::OK, "ok");
+  status.add("frames received", frames_.received());
+  status.add("frames processed", frames_.processedCount());
+  status.add("frames dropped", frames_.droppedCount());
+  addTimingValues(status, frames_.timing());
+  status.add("last drop reason", frames_.lastDropReason());
+  for (const auto& [reason, count] : frames_.dropsPerReason())
+    status.add("dropped: " + reason, count);
 }
 
 }  // namespace quadric_slam
