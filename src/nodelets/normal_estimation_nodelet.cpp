@@ -6,8 +6,9 @@
 // Publishes   points_normals (sensor_msgs/PointCloud2, organized, fields x y z normal_x normal_y
 //             normal_z curvature, NaN where there is no data, the depth image's stamp and frame)
 //             /diagnostics (health: frames processed and dropped, last reason)
-// Bad input (no camera_info yet, unsupported encoding, size mismatch, malformed buffer) gets a
-// throttled error and the frame is dropped.
+// Bad input (no camera_info yet, unsupported encoding, size mismatch, malformed buffer: see
+// ros/message_validation.h) and anything the core throws get an error, throttled per reason, and
+// the frame is dropped and counted on /diagnostics.
 #include <nodelet/nodelet.h>
 #include <pcl_conversions/pcl_conversions.h>
 #include <ros/ros.h>
@@ -23,6 +24,8 @@
 #include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
+#include "quadric_slam/ros/drop_reporter.h"
+#include "quadric_slam/ros/message_validation.h"
 #include "quadric_slam/ros/params.h"
 
 namespace quadric_slam {
@@ -48,6 +51,10 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     NODELET_INFO("normal_estimation parameters:%s", log.str().c_str());
 
     diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, "quadric_slam: normal_estimation");
+    depth_drops_ = std::make_unique<DropReporter>("normal_estimation: dropping depth frame",
+                                                  diagnostics_.get());
+    info_drops_ =
+        std::make_unique<DropReporter>("normal_estimation: ignoring camera_info", nullptr);
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("points_normals", queue_size);
     info_sub_ =
         nh.subscribe("depth/camera_info", queue_size, &NormalEstimationNodelet::onCameraInfo, this);
@@ -55,18 +62,21 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
-    const CameraIntrinsics intrinsics = intrinsicsFromCameraInfo(*info);
-    const std::string problem = intrinsics.problem();
+    const std::string problem = cameraInfoProblem(*info);
     if (!problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "normal_estimation: ignoring camera_info: %s", problem.c_str());
+      info_drops_->report(problem);
       return;
     }
     std::lock_guard<std::mutex> lock(intrinsics_mutex_);
-    intrinsics_ = intrinsics;
+    intrinsics_ = intrinsicsFromCameraInfo(*info);
     have_intrinsics_ = true;
   }
 
   void onDepth(const sensor_msgs::ImageConstPtr& image) {
+    depth_drops_->guard([&] { processDepth(image); });
+  }
+
+  void processDepth(const sensor_msgs::ImageConstPtr& image) {
     const auto start = std::chrono::steady_clock::now();
     CameraIntrinsics intrinsics;
     {
@@ -93,16 +103,14 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
             .count());
   }
 
-  void drop(const std::string& reason) {
-    NODELET_ERROR_THROTTLE(5.0, "normal_estimation: dropping depth frame: %s", reason.c_str());
-    diagnostics_->frameDropped(reason);
-  }
+  void drop(const std::string& reason) { depth_drops_->drop(reason); }
 
   BackProjectionParams back_projection_;
   std::unique_ptr<NormalEstimator> estimator_;
   // Output storage reused from frame to frame (a subscription's callbacks never run concurrently).
   pcl::PointCloud<pcl::PointNormal> with_normals_;
   std::unique_ptr<NodeletDiagnostics> diagnostics_;
+  std::unique_ptr<DropReporter> depth_drops_, info_drops_;
   std::mutex intrinsics_mutex_;
   CameraIntrinsics intrinsics_;
   bool have_intrinsics_ = false;

@@ -9,6 +9,8 @@
 //             tf ~odom_frame -> ~camera_frame (when ~publish_tf)
 //             /diagnostics (diagnostic_msgs/DiagnosticArray, at most once a second)
 // All parameters are documented in config/odometry.yaml.
+// A cloud or camera_info it cannot use (see ros/message_validation.h), or a cloud that makes the
+// core throw, gets an error, throttled per reason; dropped clouds are counted on /diagnostics.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
@@ -21,6 +23,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <pluginlib/class_list_macros.hpp>
 
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -28,9 +31,12 @@
 #include <sstream>
 #include <string>
 
-#include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
+#include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/ros/depth_image.h"
+#include "quadric_slam/ros/diagnostics.h"
+#include "quadric_slam/ros/drop_reporter.h"
+#include "quadric_slam/ros/message_validation.h"
 #include "quadric_slam/ros/params.h"
 #include "quadric_slam/ros/points_normals.h"
 
@@ -66,45 +72,48 @@ class OdometryNodelet : public nodelet::Nodelet {
     tf_broadcaster_ = std::make_unique<tf2_ros::TransformBroadcaster>();
     odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", queue_size);
     diagnostics_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 1);
+    input_diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, "quadric_slam: odometry");
+    cloud_drops_ =
+        std::make_unique<DropReporter>("odometry: dropping cloud", input_diagnostics_.get());
+    info_drops_ = std::make_unique<DropReporter>("odometry: ignoring camera_info", nullptr);
     info_sub_ = nh.subscribe("depth/camera_info", queue_size, &OdometryNodelet::onCameraInfo, this);
     cloud_sub_ = nh.subscribe("points_normals", queue_size, &OdometryNodelet::onCloud, this);
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
-    const CameraIntrinsics intrinsics = intrinsicsFromCameraInfo(*info);
-    const std::string problem = intrinsics.problem();
+    const std::string problem = cameraInfoProblem(*info);
     if (!problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: ignoring camera_info: %s", problem.c_str());
+      info_drops_->report(problem);
       return;
     }
     std::lock_guard<std::mutex> lock(intrinsics_mutex_);
-    intrinsics_ = intrinsics;
+    intrinsics_ = intrinsicsFromCameraInfo(*info);
     have_intrinsics_ = true;
   }
 
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+    cloud_drops_->guard([&] { processCloud(msg); });
+  }
+
+  void processCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+    const auto start = std::chrono::steady_clock::now();
     CameraIntrinsics intrinsics;
     {
       std::lock_guard<std::mutex> lock(intrinsics_mutex_);
       if (!have_intrinsics_) {
-        NODELET_ERROR_THROTTLE(5.0,
-                               "odometry: no valid camera_info received on %s yet; dropping "
-                               "clouds",
-                               info_sub_.getTopic().c_str());
+        cloud_drops_->drop("no valid camera_info received on " + info_sub_.getTopic() + " yet");
         return;
       }
       intrinsics = intrinsics_;
     }
-    std::string problem;
-    if (organizedCloudDecimation(intrinsics, static_cast<int>(msg->width),
-                                 static_cast<int>(msg->height), &problem) == 0) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", problem.c_str());
+    std::string problem = pointsNormalsFromMsg(*msg, cloud_);
+    if (!problem.empty()) {
+      cloud_drops_->drop(problem);
       return;
     }
-    problem = pointsNormalsFromMsg(*msg, cloud_);
-    if (!problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud from %s: %s",
-                             cloud_sub_.getTopic().c_str(), problem.c_str());
+    if (organizedCloudDecimation(intrinsics, static_cast<int>(msg->width),
+                                 static_cast<int>(msg->height), &problem) == 0) {
+      cloud_drops_->drop(problem);
       return;
     }
 
@@ -120,13 +129,10 @@ class OdometryNodelet : public nodelet::Nodelet {
     have_stamp_ = true;
     last_stamp_ = stamp;
 
-    OdometryTracker::Result result;
-    try {
-      result = tracker_->track(cloud_, intrinsics, stamp);
-    } catch (const std::invalid_argument& e) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", e.what());
-      return;
-    }
+    const OdometryTracker::Result result = tracker_->track(cloud_, intrinsics, stamp);
+    input_diagnostics_->frameProcessed(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
     ++frames_;
     counts_[static_cast<int>(result.status)]++;
     if (result.status != TrackingStatus::kOk) {
@@ -239,6 +245,9 @@ class OdometryNodelet : public nodelet::Nodelet {
   std::string camera_frame_ = "camera";
   bool publish_tf_ = true;
   std::unique_ptr<OdometryTracker> tracker_;
+  // Input health (frames processed and dropped, with the reason) beside the tracking status.
+  std::unique_ptr<NodeletDiagnostics> input_diagnostics_;
+  std::unique_ptr<DropReporter> cloud_drops_, info_drops_;
   pcl::PointCloud<pcl::PointNormal> cloud_;  // reused conversion buffer
   std::mutex intrinsics_mutex_;
   CameraIntrinsics intrinsics_;
