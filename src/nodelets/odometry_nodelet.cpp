@@ -81,6 +81,10 @@ class OdometryNodelet : public nodelet::Nodelet {
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
+    info_drops_->guard([&] { processCameraInfo(info); });
+  }
+
+  void processCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
     const std::string problem = cameraInfoProblem(*info);
     if (!problem.empty()) {
       info_drops_->report(problem);
