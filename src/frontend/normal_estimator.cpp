@@ -5,6 +5,7 @@
 #include "quadric_slam/frontend/box_gradient_normals.h"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 
@@ -88,8 +89,12 @@ void NormalEstimator::compute(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   }
 
   pcl::PointCloud<pcl::Normal> normals;
-  // PCL's estimator needs at least a few rows and columns for its smoothing window.
-  if (cloud.width > 2 && cloud.height > 2) {
+  // PCL's estimator leaves a border of normal_smoothing_size pixels on every side and reads out of
+  // bounds when the two borders overlap (its loops run to height - border, unsigned): smaller
+  // clouds keep NaN normals.
+  const auto border = static_cast<std::uint32_t>(params_.normal_smoothing_size);
+  if (cloud.width > 2 && cloud.height > 2 && cloud.width > 2 * border &&
+      cloud.height > 2 * border) {
     Estimator estimator;
     estimator.setNormalEstimationMethod(methodFromName(params_.method));
     estimator.setMaxDepthChangeFactor(static_cast<float>(params_.max_depth_change_factor));

@@ -63,6 +63,7 @@
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/frame_ids.h"
+#include "quadric_slam/ros/drop_reporter.h"
 #include "quadric_slam/ros/map_files.h"
 #include "quadric_slam/ros/map_publisher.h"
 #include "quadric_slam/ros/params.h"
@@ -235,11 +236,13 @@ class MappingNodelet : public nodelet::Nodelet {
       processFrame(*observations, *odom);
     } catch (const std::exception& e) {
       dropFrame(std::string("unexpected error: ") + e.what());
+    } catch (...) {
+      dropFrame("unexpected error of an unknown type");
     }
   }
 
   void dropFrame(const std::string& reason) {
-    NODELET_ERROR_THROTTLE(5.0, "mapping: dropping frame: %s", reason.c_str());
+    frame_drops_.report(reason);
     std::lock_guard<std::mutex> lock(stats_mutex_);
     ++stats_.frames_dropped;
     stats_.last_drop_reason = reason;
@@ -293,10 +296,8 @@ class MappingNodelet : public nodelet::Nodelet {
         why = e.what();
       }
     }
-    if (bad > 0) {
-      NODELET_ERROR_THROTTLE(5.0, "mapping: dropped %d of %zu observations at %.3f s: %s", bad,
-                             observations.observations.size(), stamp.toSec(), why.c_str());
-    }
+    if (bad > 0)
+      observation_drops_.report(why);
 
     // 4. The mapper.
     const MapperFrameResult result = mapper_->process(frame, odometry);
@@ -307,10 +308,8 @@ class MappingNodelet : public nodelet::Nodelet {
     have_stamp_ = true;
     last_stamp_ = stamp;
     T_map_odom_ = result.T_map_odom;
-    if (result.rejected_measurements > 0) {
-      NODELET_ERROR_THROTTLE(5.0, "mapping: mapper dropped %d observations at %.3f s: %s",
-                             result.rejected_measurements, stamp.toSec(), result.message.c_str());
-    }
+    if (result.rejected_measurements > 0)
+      observation_drops_.report("the mapper refused: " + result.message);
 
     // 5. The reconstruction grows on keyframes.
     if (result.keyframe) {
@@ -689,6 +688,9 @@ class MappingNodelet : public nodelet::Nodelet {
 
   // Diagnostics (stats_mutex_).
   std::mutex stats_mutex_;
+  // Errors on rosout, throttled per reason (the counts go to stats_).
+  DropReporter frame_drops_{"mapping: dropping frame", nullptr};
+  DropReporter observation_drops_{"mapping: dropping observations", nullptr};
   Stats stats_;
 
   QuadricMapPublisher map_publisher_;

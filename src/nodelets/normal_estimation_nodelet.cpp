@@ -8,8 +8,9 @@
 //             ~output_frame, or the image's frame id when that is empty, without a leading '/')
 //             /diagnostics (frames processed and dropped per reason, processing time, output
 //             rate: ros/diagnostics.h)
-// Bad input (no camera_info yet, unsupported encoding, size mismatch, malformed buffer) gets a
-// throttled error and the frame is dropped.
+// Bad input (no camera_info yet, unsupported encoding, size mismatch, malformed buffer: see
+// ros/message_validation.h) and anything the core throws get an error, throttled per reason, and
+// the frame is dropped and counted on /diagnostics.
 #include <nodelet/nodelet.h>
 #include <pcl_conversions/pcl_conversions.h>
 #include <ros/ros.h>
@@ -25,6 +26,8 @@
 #include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
+#include "quadric_slam/ros/drop_reporter.h"
+#include "quadric_slam/ros/message_validation.h"
 #include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/params.h"
 
@@ -52,6 +55,10 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     NODELET_INFO("normal_estimation parameters:%s", log.str().c_str());
 
     diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, private_nh, getName());
+    depth_drops_ = std::make_unique<DropReporter>("normal_estimation: dropping depth frame",
+                                                  diagnostics_.get());
+    info_drops_ =
+        std::make_unique<DropReporter>("normal_estimation: ignoring camera_info", nullptr);
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("points_normals", queue_size);
     info_sub_ =
         nh.subscribe("depth/camera_info", queue_size, &NormalEstimationNodelet::onCameraInfo, this);
@@ -59,18 +66,25 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
-    const CameraIntrinsics intrinsics = intrinsicsFromCameraInfo(*info);
-    const std::string problem = intrinsics.problem();
+    info_drops_->guard([&] { processCameraInfo(info); });
+  }
+
+  void processCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
+    const std::string problem = cameraInfoProblem(*info);
     if (!problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "normal_estimation: ignoring camera_info: %s", problem.c_str());
+      info_drops_->report(problem);
       return;
     }
     std::lock_guard<std::mutex> lock(intrinsics_mutex_);
-    intrinsics_ = intrinsics;
+    intrinsics_ = intrinsicsFromCameraInfo(*info);
     have_intrinsics_ = true;
   }
 
   void onDepth(const sensor_msgs::ImageConstPtr& image) {
+    depth_drops_->guard([&] { processDepth(image); });
+  }
+
+  void processDepth(const sensor_msgs::ImageConstPtr& image) {
     const auto start = std::chrono::steady_clock::now();
     CameraIntrinsics intrinsics;
     {
@@ -98,10 +112,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
             .count());
   }
 
-  void drop(const std::string& reason) {
-    NODELET_ERROR_THROTTLE(5.0, "normal_estimation: dropping depth frame: %s", reason.c_str());
-    diagnostics_->frameDropped(reason);
-  }
+  void drop(const std::string& reason) { depth_drops_->drop(reason); }
 
   BackProjectionParams back_projection_;
   std::string output_frame_;  // "" = the image's frame
@@ -109,6 +120,7 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
   // Output storage reused from frame to frame (a subscription's callbacks never run concurrently).
   pcl::PointCloud<pcl::PointNormal> with_normals_;
   std::unique_ptr<NodeletDiagnostics> diagnostics_;
+  std::unique_ptr<DropReporter> depth_drops_, info_drops_;
   std::mutex intrinsics_mutex_;
   CameraIntrinsics intrinsics_;
   bool have_intrinsics_ = false;

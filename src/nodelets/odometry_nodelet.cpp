@@ -17,6 +17,8 @@
 // All parameters are documented in config/odometry.yaml. The cloud's own frame id is not used: the
 // pose is that of ~camera_frame, our name for the tracked optical frame (normal_estimation's
 // ~output_frame gives the clouds the same name in quadric_slam.launch).
+// A cloud or camera_info it cannot use (see ros/message_validation.h), or a cloud that makes the
+// core throw, gets an error, throttled per reason; dropped clouds are counted on /diagnostics.
 #include <geometry_msgs/TransformStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
@@ -44,6 +46,8 @@
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/frame_ids.h"
+#include "quadric_slam/ros/drop_reporter.h"
+#include "quadric_slam/ros/message_validation.h"
 #include "quadric_slam/ros/params.h"
 #include "quadric_slam/ros/points_normals.h"
 
@@ -81,6 +85,8 @@ class OdometryNodelet : public nodelet::Nodelet {
     odom_pub_ = nh.advertise<nav_msgs::Odometry>("odom", queue_size);
     diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, private_nh, getName());
     diagnostics_->addTask("tracking", this, &OdometryNodelet::diagnoseTracking);
+    cloud_drops_ = std::make_unique<DropReporter>("odometry: dropping cloud", diagnostics_.get());
+    info_drops_ = std::make_unique<DropReporter>("odometry: ignoring camera_info", nullptr);
     info_sub_ = nh.subscribe("depth/camera_info", queue_size, &OdometryNodelet::onCameraInfo, this);
     if (use_observations_) {
       cloud_filter_.subscribe(nh, "points_normals", queue_size);
@@ -92,10 +98,17 @@ class OdometryNodelet : public nodelet::Nodelet {
     }
   }
 
-  void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) { track(msg, nullptr); }
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+    cloud_drops_->guard([&] { track(msg, nullptr); });
+  }
 
   void onCloudAndObservations(const sensor_msgs::PointCloud2ConstPtr& msg,
                               const QuadricObservationArrayConstPtr& observations) {
+    cloud_drops_->guard([&] { trackWithObservations(msg, observations); });
+  }
+
+  void trackWithObservations(const sensor_msgs::PointCloud2ConstPtr& msg,
+                             const QuadricObservationArrayConstPtr& observations) {
     int rejected = 0;
     const FrameMeasurements frame = fromObservationArrayMsg(*observations, &rejected);
     if (rejected > 0) {
@@ -109,14 +122,17 @@ class OdometryNodelet : public nodelet::Nodelet {
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
-    const CameraIntrinsics intrinsics = intrinsicsFromCameraInfo(*info);
-    const std::string problem = intrinsics.problem();
+    info_drops_->guard([&] { processCameraInfo(info); });
+  }
+
+  void processCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
+    const std::string problem = cameraInfoProblem(*info);
     if (!problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "odometry: ignoring camera_info: %s", problem.c_str());
+      info_drops_->report(problem);
       return;
     }
     std::lock_guard<std::mutex> lock(intrinsics_mutex_);
-    intrinsics_ = intrinsics;
+    intrinsics_ = intrinsicsFromCameraInfo(*info);
     have_intrinsics_ = true;
   }
 
@@ -132,15 +148,14 @@ class OdometryNodelet : public nodelet::Nodelet {
       }
       intrinsics = intrinsics_;
     }
-    std::string problem;
-    if (organizedCloudDecimation(intrinsics, static_cast<int>(msg->width),
-                                 static_cast<int>(msg->height), &problem) == 0) {
-      drop(problem);
+    std::string problem = pointsNormalsFromMsg(*msg, cloud_);
+    if (!problem.empty()) {
+      cloud_drops_->drop(problem);
       return;
     }
-    problem = pointsNormalsFromMsg(*msg, cloud_);
-    if (!problem.empty()) {
-      drop("points_normals cloud: " + problem);
+    if (organizedCloudDecimation(intrinsics, static_cast<int>(msg->width),
+                                 static_cast<int>(msg->height), &problem) == 0) {
+      cloud_drops_->drop(problem);
       return;
     }
 
@@ -156,13 +171,8 @@ class OdometryNodelet : public nodelet::Nodelet {
     have_stamp_ = true;
     last_stamp_ = stamp;
 
-    OdometryTracker::Result result;
-    try {
-      result = tracker_->track(cloud_, intrinsics, stamp, observations);
-    } catch (const std::invalid_argument& e) {
-      drop(e.what());
-      return;
-    }
+    // (What the tracker throws is caught by the guard around this callback and counted as a drop.)
+    const OdometryTracker::Result result = tracker_->track(cloud_, intrinsics, stamp, observations);
     if (result.status != TrackingStatus::kOk) {
       NODELET_WARN_THROTTLE(5.0, "odometry: tracking %s: %s", toString(result.status),
                             result.icp.message.c_str());
@@ -183,10 +193,7 @@ class OdometryNodelet : public nodelet::Nodelet {
             .count());
   }
 
-  void drop(const std::string& reason) {
-    NODELET_ERROR_THROTTLE(5.0, "odometry: dropping cloud: %s", reason.c_str());
-    diagnostics_->frameDropped(reason);
-  }
+  void drop(const std::string& reason) { cloud_drops_->drop(reason); }
 
   void publishOdometry(const OdometryTracker::Result& result, const ros::Time& stamp) {
     auto odom = boost::make_shared<nav_msgs::Odometry>();
@@ -281,6 +288,8 @@ class OdometryNodelet : public nodelet::Nodelet {
   long counts_[3] = {0, 0, 0};
   OdometryTracker::Result last_result_;
   std::unique_ptr<NodeletDiagnostics> diagnostics_;
+  // Input health (frames processed and dropped, with the reason) beside the tracking status.
+  std::unique_ptr<DropReporter> cloud_drops_, info_drops_;
   bool use_observations_ = false;
   ros::Subscriber cloud_sub_, info_sub_;
   using Synchronizer =

@@ -14,7 +14,9 @@
 //             unassigned; only computed while subscribed)
 //             /diagnostics (frames processed and dropped per reason, processing time, output
 //             rate: ros/diagnostics.h)
-// A cloud without normal fields or not organized gets a throttled error and is dropped.
+// A cloud the segmenter cannot read (see ros/message_validation.h: missing or non-float32 normal
+// fields, not organized, inconsistent sizes) or that makes the core throw gets an error, throttled
+// per reason, and is dropped and counted on /diagnostics.
 #include <nodelet/nodelet.h>
 #include <pcl_conversions/pcl_conversions.h>
 #include <ros/ros.h>
@@ -26,7 +28,6 @@
 #include <cstring>
 #include <memory>
 #include <pluginlib/class_list_macros.hpp>
-#include <set>
 #include <string>
 
 #include "quadric_slam/QuadricObservationArray.h"
@@ -35,34 +36,12 @@
 #include "quadric_slam/pipeline/segmenter_params.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/diagnostics.h"
+#include "quadric_slam/ros/drop_reporter.h"
 #include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/params.h"
+#include "quadric_slam/ros/points_normals.h"
 
 namespace quadric_slam {
-
-namespace {
-
-// Empty when the cloud has the fields and layout the segmenter needs, else the problem.
-std::string cloudProblem(const sensor_msgs::PointCloud2& cloud) {
-  std::set<std::string> fields;
-  for (const auto& f : cloud.fields)
-    fields.insert(f.name);
-  std::string missing;
-  for (const char* name : {"x", "y", "z", "normal_x", "normal_y", "normal_z"})
-    if (!fields.count(name))
-      missing += std::string(missing.empty() ? "" : ", ") + name;
-  if (!missing.empty())
-    return "the cloud lacks the field(s) " + missing +
-           " (points_normals must carry normals, e.g. from quadric_slam/NormalEstimation)";
-  if (cloud.height <= 1 && cloud.width > 1)
-    return "the cloud is not organized (height 1); an organized depth-image cloud is required";
-  if (static_cast<std::size_t>(cloud.row_step) * cloud.height > cloud.data.size() ||
-      static_cast<std::size_t>(cloud.point_step) * cloud.width > cloud.row_step)
-    return "malformed cloud: data smaller than row_step * height";
-  return "";
-}
-
-}  // namespace
 
 class QuadricSegmentationNodelet : public nodelet::Nodelet {
  private:
@@ -88,6 +67,8 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
     NODELET_INFO("quadric_segmentation parameters:%s", log.str().c_str());
 
     diagnostics_ = std::make_unique<NodeletDiagnostics>(nh, private_nh, getName());
+    drops_ =
+        std::make_unique<DropReporter>("quadric_segmentation: dropping cloud", diagnostics_.get());
     observations_pub_ = nh.advertise<QuadricObservationArray>("observations", queue_size);
     image_pub_ = private_nh.advertise<sensor_msgs::Image>("segmentation_image", 1);
     cloud_pub_ = private_nh.advertise<sensor_msgs::PointCloud2>("segmented_cloud", 1);
@@ -96,22 +77,17 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
   }
 
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+    drops_->guard([&] { processCloud(msg); });
+  }
+
+  void processCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     const auto start = std::chrono::steady_clock::now();
-    const std::string problem = cloudProblem(*msg);
-    if (!problem.empty()) {
-      NODELET_ERROR_THROTTLE(5.0, "quadric_segmentation: dropping cloud: %s", problem.c_str());
-      diagnostics_->frameDropped(problem);
-      return;
-    }
-    // roscpp does not catch what a callback throws: the manager, and every nodelet in it, would
-    // die. Whatever the core throws drops this cloud with a reason instead.
-    try {
+    {
       pcl::PointCloud<pcl::PointNormal> cloud;
-      pcl::fromROSMsg(*msg, cloud);
-      if (cloud.height <= 1 && !cloud.empty()) {
-        // A single point or a 1 x N row: organized enough for the segmenter's grid.
-        cloud.height = 1;
-        cloud.width = static_cast<std::uint32_t>(cloud.size());
+      const std::string problem = pointsNormalsFromMsg(*msg, cloud);
+      if (!problem.empty()) {
+        drops_->drop(problem);
+        return;
       }
       const Segmentation segmentation = segmenter_->segment(cloud);
 
@@ -123,8 +99,7 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
       FrameMeasurements measurements =
           toFrameMeasurements(segmentation, header.stamp.toSec(), header.frame_id);
       attachSupportPoints(measurements, segmentation, cloud, max_support_points_);
-      auto out = boost::make_shared<QuadricObservationArray>(toObservationArrayMsg(
-          measurements));
+      auto out = boost::make_shared<QuadricObservationArray>(toObservationArrayMsg(measurements));
       out->header = header;
       observations_pub_.publish(out);
 
@@ -132,10 +107,6 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
         publishImage(segmentation, header);
       if (cloud_pub_.getNumSubscribers() > 0)
         publishCloud(cloud, segmentation, header);
-    } catch (const std::exception& e) {
-      NODELET_ERROR_THROTTLE(5.0, "quadric_segmentation: dropping cloud: %s", e.what());
-      diagnostics_->frameDropped(e.what());
-      return;
     }
     diagnostics_->frameProcessed(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -176,6 +147,7 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
   std::unique_ptr<QuadricSegmenter> segmenter_;
   int max_support_points_ = 1000;
   std::unique_ptr<NodeletDiagnostics> diagnostics_;
+  std::unique_ptr<DropReporter> drops_;
   ros::Subscriber cloud_sub_;
   ros::Publisher observations_pub_, image_pub_, cloud_pub_;
 };

@@ -3,7 +3,6 @@
 #include <sensor_msgs/image_encodings.h>
 
 #include <cstdint>
-#include <sstream>
 
 namespace quadric_slam {
 namespace {
@@ -12,9 +11,6 @@ namespace enc = sensor_msgs::image_encodings;
 
 bool isMetres(const std::string& encoding) {
   return encoding == enc::TYPE_32FC1;
-}
-bool isMillimetres(const std::string& encoding) {
-  return encoding == enc::TYPE_16UC1 || encoding == enc::MONO16;
 }
 
 template <typename T>
@@ -41,28 +37,6 @@ CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info) {
   return intrinsics;
 }
 
-std::string depthImageProblem(const sensor_msgs::Image& image) {
-  std::size_t pixel_bytes = 0;
-  if (isMetres(image.encoding)) {
-    pixel_bytes = sizeof(float);
-  } else if (isMillimetres(image.encoding)) {
-    pixel_bytes = sizeof(std::uint16_t);
-  } else {
-    return "unsupported depth encoding '" + image.encoding +
-           "' (expected 32FC1 metres or 16UC1 millimetres)";
-  }
-  if (image.is_bigendian)
-    return "big-endian depth images are not supported";
-  if (image.step < image.width * pixel_bytes ||
-      image.data.size() < static_cast<std::size_t>(image.step) * image.height) {
-    std::ostringstream why;
-    why << "malformed " << image.encoding << " image (" << image.width << " x " << image.height
-        << ", step " << image.step << ", " << image.data.size() << " bytes)";
-    return why.str();
-  }
-  return "";
-}
-
 std::string depthImageToCloud(const sensor_msgs::Image& image, const CameraIntrinsics& intrinsics,
                               const BackProjectionParams& params,
                               pcl::PointCloud<pcl::PointXYZ>& cloud) {
@@ -73,6 +47,12 @@ std::string depthImageToCloud(const sensor_msgs::Image& image, const CameraIntri
   }
   if (!problem.empty())
     return problem;
+  const int d = params.decimation;
+  if (d < 1 || image.width / d < kMinGridSide || image.height / d < kMinGridSide) {
+    return "depth image " + std::to_string(image.width) + " x " + std::to_string(image.height) +
+           " at decimation " + std::to_string(d) + " leaves fewer than " +
+           std::to_string(kMinGridSide) + " x " + std::to_string(kMinGridSide) + " points";
+  }
   if (isMetres(image.encoding)) {
     cloud = backProject(viewOf<float>(image, 1.0), intrinsics, params);
   } else {

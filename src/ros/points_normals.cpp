@@ -1,47 +1,33 @@
 #include "quadric_slam/ros/points_normals.h"
 
 #include <cstring>
-#include <sstream>
+
+#include "quadric_slam/ros/message_validation.h"
 
 #include "quadric_slam/ros/frame_ids.h"
 
 namespace quadric_slam {
 namespace {
 
-// Byte offset of a float32 field with one element that fits in a point, or -1.
-int floatField(const sensor_msgs::PointCloud2& msg, const std::string& name) {
+std::uint32_t fieldOffset(const sensor_msgs::PointCloud2& msg, const std::string& name) {
   for (const auto& field : msg.fields) {
-    if (field.name == name) {
-      const bool ok = field.datatype == sensor_msgs::PointField::FLOAT32 && field.count == 1 &&
-                      field.offset + sizeof(float) <= msg.point_step;
-      return ok ? static_cast<int>(field.offset) : -1;
-    }
+    if (field.name == name)
+      return field.offset;
   }
-  return -1;
+  return 0;  // not reached: pointCloudProblem() found every field
 }
 
 }  // namespace
 
 std::string pointsNormalsFromMsg(const sensor_msgs::PointCloud2& msg,
                                  pcl::PointCloud<pcl::PointNormal>& cloud) {
-  const char* const names[6] = {"x", "y", "z", "normal_x", "normal_y", "normal_z"};
-  int offsets[6];
-  for (int i = 0; i < 6; ++i) {
-    offsets[i] = floatField(msg, names[i]);
-    if (offsets[i] < 0) {
-      return std::string("cloud has no float32 field '") + names[i] +
-             "' (needs x y z normal_x normal_y normal_z, e.g. from quadric_slam/NormalEstimation)";
-    }
-  }
-  if (msg.is_bigendian)
-    return "big-endian clouds are not supported";
-  if (msg.data.size() < static_cast<std::size_t>(msg.row_step) * msg.height ||
-      msg.row_step < msg.point_step * msg.width) {
-    std::ostringstream why;
-    why << "malformed cloud (" << msg.width << " x " << msg.height << ", point_step "
-        << msg.point_step << ", row_step " << msg.row_step << ", " << msg.data.size() << " bytes)";
-    return why.str();
-  }
+  const std::string problem = pointCloudProblem(msg, pointsNormalsLayout());
+  if (!problem.empty())
+    return problem;
+  const std::vector<std::string>& names = pointsNormalsLayout().float32_fields;
+  std::uint32_t offsets[6];
+  for (int i = 0; i < 6; ++i)
+    offsets[i] = fieldOffset(msg, names[i]);
   cloud.header.frame_id = withoutLeadingSlash(msg.header.frame_id);
   cloud.width = msg.width;
   cloud.height = msg.height;

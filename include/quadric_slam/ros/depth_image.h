@@ -10,18 +10,16 @@
 #include <string>
 
 #include "quadric_slam/frontend/frame.h"
+#include "quadric_slam/ros/message_validation.h"
 
 namespace quadric_slam {
 
 // Intrinsics from camera_info's K and size (check .problem() before use).
 CameraIntrinsics intrinsicsFromCameraInfo(const sensor_msgs::CameraInfo& info);
 
-// Empty when the image is a depth image this package reads and its buffer is consistent, else the
-// reason (unsupported encoding, big-endian data, short buffer).
-std::string depthImageProblem(const sensor_msgs::Image& image);
-
 // Back-projects a depth image into an organized cloud. Returns the problem that prevents it
-// (depthImageProblem(), or the image size not matching the intrinsics); cloud is untouched then.
+// (depthImageProblem() of message_validation.h, the image size not matching the intrinsics, or a
+// decimated cloud smaller than kMinGridSide on a side); cloud is untouched then.
 std::string depthImageToCloud(const sensor_msgs::Image& image, const CameraIntrinsics& intrinsics,
                               const BackProjectionParams& params,
                               pcl::PointCloud<pcl::PointXYZ>& cloud);

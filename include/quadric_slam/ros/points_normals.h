@@ -11,9 +11,9 @@
 namespace quadric_slam {
 
 // Copies x y z normal_x normal_y normal_z by field offset (curvature need not be present; it is
-// set to 0). Returns the problem that prevents it (a missing or non-float32 field, a malformed or
-// big-endian buffer); cloud is left untouched then. Reuses cloud's storage. The cloud's frame id is
-// the message's without a leading '/'.
+// set to 0). Returns the problem that prevents it (pointCloudProblem() with pointsNormalsLayout(),
+// message_validation.h); cloud is left untouched then. Reuses cloud's storage. The cloud's frame id
+// is the message's without a leading '/'.
 std::string pointsNormalsFromMsg(const sensor_msgs::PointCloud2& msg,
                                  pcl::PointCloud<pcl::PointNormal>& cloud);
 

@@ -47,7 +47,7 @@ TEST(PointsNormals, CloudsWithoutNormalsOrMalformedAreRefused) {
   pcl::PointCloud<pcl::PointNormal> with_normals(4, 3);
   pcl::toROSMsg(with_normals, msg);
   msg.data.resize(msg.data.size() / 2);
-  EXPECT_NE(qs::pointsNormalsFromMsg(msg, out).find("malformed"), std::string::npos);
+  EXPECT_NE(qs::pointsNormalsFromMsg(msg, out).find("data has"), std::string::npos);
   pcl::toROSMsg(with_normals, msg);
   msg.is_bigendian = true;
   EXPECT_NE(qs::pointsNormalsFromMsg(msg, out).find("big-endian"), std::string::npos);
