@@ -12,6 +12,7 @@
 // one, so that the comparison is about the computation and not about frames dropped by a loaded
 // machine.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <pcl/io/pcd_io.h>
@@ -113,7 +114,7 @@ SlamRun runOffline(const std::string& bag_path, const fs::path& out_dir) {
 class LiveOfflineTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::path(testing::TempDir()) / "live_offline_test";
+    dir_ = fs::path(testing::TempDir()) / ("live_offline_test_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     bag_path_ = (dir_ / "desk.bag").string();

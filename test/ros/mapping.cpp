@@ -7,6 +7,7 @@
 // again (time going backwards), and bad input that must be dropped without harm.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <quadric_slam/LoadMap.h>
@@ -60,7 +61,7 @@ qs::MapFile toMapFile(const quadric_slam::QuadricMap& map) {
 class MappingTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::path(testing::TempDir()) / "mapping_test";
+    dir_ = fs::path(testing::TempDir()) / ("mapping_test_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
     bag_path_ = (dir_ / "desk.bag").string();

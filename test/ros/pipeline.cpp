@@ -3,6 +3,7 @@
 // the pipeline publishes: points_normals and odom per frame, frame ids, tf, and the odometry's
 // error against the ground truth.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <nav_msgs/Odometry.h>
 #include <quadric_slam/QuadricObservationArray.h>
 #include <ros/ros.h>
@@ -30,7 +31,7 @@ constexpr double kRate = 30.0;    // the desk scene's camera rate
 class PipelineTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    bag_path_ = testing::TempDir() + "/pipeline_test.bag";
+    bag_path_ = testing::TempDir() + "/pipeline_test_" + std::to_string(::getpid()) + ".bag";
     truth_ = qs::test::writeDeskBag(bag_path_, kRate, kSeconds, 7).truth;
   }
   void TearDown() override { std::filesystem::remove(bag_path_); }

@@ -3,6 +3,7 @@
 // and the mapper; the mapped trajectory is as accurate as the odometry, the map holds the scene's
 // primitives without duplicates or spurious landmarks, and the reconstruction is written.
 #include <gtest/gtest.h>
+#include <unistd.h>
 #include <sys/wait.h>
 
 #include <array>
@@ -50,7 +51,8 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
     if (!fs::exists(toolDir() / tool))
       GTEST_SKIP() << tool << " is not built in " << toolDir();
   }
-  const fs::path dir = fs::path(testing::TempDir()) / "run_bag_mapping";
+  const fs::path dir =
+      fs::path(testing::TempDir()) / ("run_bag_mapping_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   int code = -1;
   run("synth",
