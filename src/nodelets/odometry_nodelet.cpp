@@ -90,6 +90,9 @@ class OdometryNodelet : public nodelet::Nodelet {
     info_sub_ = nh.subscribe("depth/camera_info", queue_size, &OdometryNodelet::onCameraInfo, this);
     if (use_observations_) {
       cloud_filter_.subscribe(nh, "points_normals", queue_size);
+      // A cloud the segmentation refuses never gets observations, so the pair never forms:
+      // report a bad cloud when it arrives, not only when it is paired.
+      cloud_filter_.registerCallback(&OdometryNodelet::onCloudArrived, this);
       observations_filter_.subscribe(nh, "observations", queue_size);
       sync_ = std::make_unique<Synchronizer>(cloud_filter_, observations_filter_, queue_size);
       sync_->registerCallback(&OdometryNodelet::onCloudAndObservations, this);
@@ -100,6 +103,14 @@ class OdometryNodelet : public nodelet::Nodelet {
 
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
     cloud_drops_->guard([&] { track(msg, nullptr); });
+  }
+
+  void onCloudArrived(const sensor_msgs::PointCloud2ConstPtr& msg) {
+    cloud_drops_->guard([&] {
+      const std::string problem = pointCloudProblem(*msg, pointsNormalsLayout());
+      if (!problem.empty())
+        cloud_drops_->drop(problem);
+    });
   }
 
   void onCloudAndObservations(const sensor_msgs::PointCloud2ConstPtr& msg,
