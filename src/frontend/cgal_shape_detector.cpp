@@ -5,6 +5,7 @@
 #include <CGAL/Shape_detection/Efficient_RANSAC.h>
 #include <CGAL/property_map.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -23,10 +24,47 @@ using NormalMap = CGAL::Nth_of_tuple_property_map<1, PointWithNormal>;
 using Traits =
     CGAL::Shape_detection::Efficient_RANSAC_traits<Kernel, PwnVector, PointMap, NormalMap>;
 using EfficientRansac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
-using CgalPlane = CGAL::Shape_detection::Plane<Traits>;
-using CgalSphere = CGAL::Shape_detection::Sphere<Traits>;
-using CgalCylinder = CGAL::Shape_detection::Cylinder<Traits>;
-using CgalCone = CGAL::Shape_detection::Cone<Traits>;
+
+// CGAL's connected_component() labels a bitmap over the shape's 2D parameter space, of
+// ceil(u range / cluster_epsilon) x ceil(v range / cluster_epsilon) cells, without checking that
+// size: a candidate with a huge radius, or with NaN parameters (a sample on a cylinder's axis),
+// makes the product overflow or its conversion undefined, and the labelling writes out of bounds
+// (found by the hostile-input fuzz: a real-looking depth image with four flipped bytes). Such a
+// candidate is clustered with CGAL's kd-tree search instead, which needs no grid; every other
+// candidate keeps CGAL's grid, so ordinary results do not change.
+template <class CgalShape>
+class BoundedGridShape : public CgalShape {
+ public:
+  using FT = typename CgalShape::FT;
+
+ protected:
+  std::size_t connected_component(std::vector<std::size_t>& indices, FT cluster_epsilon) override {
+    if (!indices.empty() && this->supports_connected_component() &&
+        !gridIsBounded(indices.size(), cluster_epsilon))
+      return this->connected_component_kdTree(indices, cluster_epsilon);
+    return CgalShape::connected_component(indices, cluster_epsilon);
+  }
+
+ private:
+  // At most this many cells (4 bytes each): a 20 m x 20 m patch at 1 cm.
+  static constexpr double kMaxGridCells = 4e6;
+
+  bool gridIsBounded(std::size_t count, FT cluster_epsilon) const {
+    FT min[] = {0, 0}, max[] = {0, 0};
+    std::vector<std::pair<FT, FT>> parameter_space(count);
+    FT epsilon = cluster_epsilon;  // parameters() may adjust its copy, as CGAL's own call does
+    this->parameters(this->m_indices, parameter_space, epsilon, min, max);
+    const double u = (max[0] - min[0]) / epsilon;
+    const double v = (max[1] - min[1]) / epsilon;
+    return std::isfinite(u) && std::isfinite(v) && u >= 0 && v >= 0 &&
+           (u + 1) * (v + 1) <= kMaxGridCells;
+  }
+};
+
+using CgalPlane = BoundedGridShape<CGAL::Shape_detection::Plane<Traits>>;
+using CgalSphere = BoundedGridShape<CGAL::Shape_detection::Sphere<Traits>>;
+using CgalCylinder = BoundedGridShape<CGAL::Shape_detection::Cylinder<Traits>>;
+using CgalCone = BoundedGridShape<CGAL::Shape_detection::Cone<Traits>>;
 
 Eigen::Vector3d toEigen(const Kernel::Point_3& p) {
   return Eigen::Vector3d(p.x(), p.y(), p.z());
