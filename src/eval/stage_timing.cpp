@@ -30,10 +30,49 @@ TimingSummary summarize(const std::vector<double>& durations_ms) {
   return s;
 }
 
+DurationReservoir::DurationReservoir(std::size_t capacity)
+    : capacity_(std::max<std::size_t>(1, capacity)) {}
+
+void DurationReservoir::add(double duration_ms) {
+  ++count_;
+  sum_ += duration_ms;
+  max_ = count_ == 1 ? duration_ms : std::max(max_, duration_ms);
+  if (sample_.size() < capacity_) {
+    sample_.push_back(duration_ms);
+    return;
+  }
+  // Algorithm R: the n-th duration replaces a random kept one with probability capacity / n.
+  random_state_ = random_state_ * 6364136223846793005ULL + 1442695040888963407ULL;  // 64-bit LCG
+  const std::size_t slot = static_cast<std::size_t>((random_state_ >> 11) % count_);
+  if (slot < capacity_)
+    sample_[slot] = duration_ms;
+}
+
+void DurationReservoir::merge(const DurationReservoir& other) {
+  if (other.count_ == 0)
+    return;
+  const std::size_t count = count_ + other.count_;
+  const double sum = sum_ + other.sum_;
+  const double max = count_ == 0 ? other.max_ : std::max(max_, other.max_);
+  for (const double d : other.sample_)
+    add(d);
+  count_ = count;
+  sum_ = sum;
+  max_ = max;
+}
+
+TimingSummary DurationReservoir::summary() const {
+  TimingSummary s = summarize(sample_);
+  s.count = count_;
+  s.max_ms = max_;
+  s.mean_ms = count_ > 0 ? sum_ / static_cast<double>(count_) : 0.0;
+  return s;
+}
+
 std::map<std::string, TimingSummary> StageTimer::summaries() const {
   std::map<std::string, TimingSummary> out;
   for (const auto& [stage, durations] : stages_)
-    out[stage] = summarize(durations);
+    out[stage] = durations.summary();
   return out;
 }
 

@@ -64,7 +64,7 @@ SequenceGenerator::Stats SequenceGenerator::run(const std::vector<StampedPose>& 
       try {
         const auto t0 = std::chrono::steady_clock::now();
         auto frame = std::make_unique<RenderedFrame>(
-            renderer_.render(poses[index].T_world_sensor, params_.seed * 1000003ULL + index));
+            renderer_.render(poses[index].T_world_sensor, frameNoiseSeed(params_.seed, index)));
         const double render = secondsSince(t0);
         std::vector<int> counts(max_id + 1, 0);
         for (int v = 0; v < frame->labels.rows; ++v) {

@@ -8,23 +8,29 @@
 //   DIR/timing.json          per-stage median/p95/max
 //   DIR/map.yaml             the landmarks (map schema), unless --odometry-only
 //   DIR/reconstruction.pcd   landmark points projected onto their surfaces (label = landmark id)
+//   DIR/resources.csv        every --sample-every frames: resident memory, frame time, landmarks
 // With --gt prints the ATE and RPE of the odometry (ate_rmse_m ...) and of SLAM (map_ate_rmse_m
-// ...).
+// ...). INPUT may also be a scene file (config/scenes/*.yaml): its frames are rendered as they are
+// needed (sim/synthetic_frame_source.h), so a sequence of any length runs without a bag; the truth
+// goes to DIR/groundtruth.txt and is used when --gt is not given.
 //
 //   run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR] [--max-frames N]
-//           [--intrinsics fx,fy,cx,cy] [--quiet]
+//           [--intrinsics fx,fy,cx,cy] [--quiet] [--sample-every N]
+//           [--seconds S] [--rate HZ] [--seed N]   (scene INPUT only)
 #include <pcl/io/pcd_io.h>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <sstream>
 #include <string>
 
+#include "quadric_slam/eval/resource_usage.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
 #include "quadric_slam/io/landmark_map_file.h"
 #include "quadric_slam/io/map_yaml.h"
@@ -32,7 +38,8 @@
 #include "quadric_slam/io/tum_folder_reader.h"
 #include "quadric_slam/pipeline/quadric_slam.h"
 #include "quadric_slam/ros/tum_bag_reader.h"
-
+#include "quadric_slam/sim/scene_yaml.h"
+#include "quadric_slam/sim/synthetic_frame_source.h"
 
 namespace qs = quadric_slam;
 namespace fs = std::filesystem;
@@ -45,15 +52,26 @@ struct Options {
   bool odometry_only = false;
   bool quiet = false;
   long max_frames = -1;
-  qs::CameraIntrinsics intrinsics;  // fx = 0: from the input
+  long sample_every = 30;
+  qs::CameraIntrinsics intrinsics;             // fx = 0: from the input
+  qs::SyntheticFrameSource::Params synthetic;  // a scene INPUT
 };
+
+bool isSceneFile(const std::string& input) {
+  const fs::path path(input);
+  return fs::is_regular_file(path) && (path.extension() == ".yaml" || path.extension() == ".yml");
+}
 
 int usage(const std::string& problem) {
   std::cerr
       << "run_bag: " << problem << "\n"
       << "usage: run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR]\n"
       << "               [--max-frames N] [--intrinsics fx,fy,cx,cy] [--quiet]\n"
-      << "  INPUT: a TUM rosbag (.bag) or a TUM folder (rgb.txt, depth.txt, depth/)\n";
+      << "               [--sample-every N] [--seconds S] [--rate HZ] [--seed N]\n"
+      << "  INPUT: a TUM rosbag (.bag), a TUM folder (rgb.txt, depth.txt, depth/), or a scene\n"
+      << "         file (config/scenes/*.yaml) rendered frame by frame: --seconds (default 60),\n"
+      << "         --rate (default: the scene's), --seed (default 1) apply to it\n"
+      << "  --sample-every N: a line of DIR/resources.csv every N frames (default 30)\n";
   return 2;
 }
 
@@ -78,6 +96,16 @@ bool parseOptions(int argc, char** argv, Options& o, std::string& problem) {
         o.odometry_only = true;
       } else if (arg == "--quiet") {
         o.quiet = true;
+      } else if (arg == "--sample-every") {
+        o.sample_every = std::stol(value());
+        if (o.sample_every < 1)
+          throw std::invalid_argument("--sample-every must be >= 1");
+      } else if (arg == "--seconds") {
+        o.synthetic.seconds = std::stod(value());
+      } else if (arg == "--rate") {
+        o.synthetic.rate = std::stod(value());
+      } else if (arg == "--seed") {
+        o.synthetic.seed = std::stoull(value());
       } else if (arg == "--intrinsics") {
         if (!qs::parseIntrinsics(value(), o.intrinsics))
           throw std::invalid_argument("--intrinsics takes fx,fy,cx,cy");
@@ -101,6 +129,14 @@ bool parseOptions(int argc, char** argv, Options& o, std::string& problem) {
 }
 
 std::unique_ptr<qs::FrameSource> openInput(const Options& o) {
+  if (isSceneFile(o.input)) {
+    qs::Scene scene = qs::readSceneYaml(o.input);
+    if (o.intrinsics.fx > 0)
+      throw std::invalid_argument("--intrinsics does not apply to a scene (set its camera)");
+    qs::SyntheticFrameSource::Params params = o.synthetic;
+    params.rgb = false;  // depth is all the pipeline uses
+    return std::make_unique<qs::SyntheticFrameSource>(scene, params);
+  }
   if (fs::is_directory(o.input)) {
     qs::TumFolderReader::Params params;
     params.load_rgb = false;  // depth is all the pipeline uses
@@ -152,6 +188,17 @@ int main(int argc, char** argv) {
     const std::size_t total =
         o.max_frames >= 0 ? std::min<std::size_t>(source->size(), o.max_frames) : source->size();
     fs::create_directories(o.out_dir);
+    if (const auto* synthetic = dynamic_cast<const qs::SyntheticFrameSource*>(source.get())) {
+      const std::string truth = o.out_dir + "/groundtruth.txt";
+      qs::writeTumTrajectory(synthetic->groundTruth(), truth,
+                             "quadric_slam run_bag: ground truth of the rendered scene " + o.input);
+      if (o.gt_path.empty())
+        o.gt_path = truth;
+    }
+    // Long-run curves: memory, time per frame and map size every sample_every frames.
+    std::ofstream resources(o.out_dir + "/resources.csv");
+    resources << "frames,stamp_s,elapsed_s,rss_mb,ms_per_frame,landmarks\n";
+    auto last_sample = std::chrono::steady_clock::now();
     if (!o.quiet) {
       std::cerr << "run_bag: " << o.input << ": " << total << " frames, config " << o.config_dir
                 << (o.odometry_only ? ", odometry only" : "") << "\n";
@@ -183,6 +230,18 @@ int main(int argc, char** argv) {
         map_trajectory.push_back({frame.stamp, result.mapping.T_map_camera});
       else if (!o.odometry_only && result.tracking)
         std::cerr << "\nrun_bag: frame " << frame.stamp << ": " << result.message << "\n";
+      if (frames % o.sample_every == 0 || frames == total) {
+        const auto now = std::chrono::steady_clock::now();
+        const std::size_t in_interval =
+            frames % o.sample_every == 0 ? o.sample_every : frames % o.sample_every;
+        resources << frames << ',' << std::fixed << std::setprecision(6) << frame.stamp << ','
+                  << std::setprecision(3) << std::chrono::duration<double>(now - start).count()
+                  << ',' << qs::residentMemoryBytes() / 1048576.0 << ','
+                  << std::chrono::duration<double, std::milli>(now - last_sample).count() /
+                         in_interval
+                  << ',' << slam.mapper().map().landmarks().size() << '\n';
+        last_sample = now;
+      }
       if (!o.quiet && (frames % 30 == 0 || frames == total)) {
         const double elapsed =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -218,9 +277,10 @@ int main(int argc, char** argv) {
       std::printf("\n");
     }
     std::fputs(timer.table().c_str(), stdout);
-    std::printf("trajectory %s/trajectory.txt\ntrajectory_odom %s/trajectory_odom.txt\n"
-                "timing %s/timing.json\n",
-                o.out_dir.c_str(), o.out_dir.c_str(), o.out_dir.c_str());
+    std::printf(
+        "trajectory %s/trajectory.txt\ntrajectory_odom %s/trajectory_odom.txt\n"
+        "timing %s/timing.json\nresources %s/resources.csv\n",
+        o.out_dir.c_str(), o.out_dir.c_str(), o.out_dir.c_str(), o.out_dir.c_str());
     if (!o.odometry_only) {
       const std::vector<qs::QuadricLandmark> landmarks = slam.mapper().landmarks();
       qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"), o.out_dir + "/map.yaml");

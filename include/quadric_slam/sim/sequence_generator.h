@@ -13,6 +13,12 @@
 
 namespace quadric_slam {
 
+// Seed of frame `index`'s depth noise in a sequence seeded with `seed` (one stream per frame, so
+// the frames do not depend on the order or thread they are rendered in).
+inline std::uint64_t frameNoiseSeed(std::uint64_t seed, std::size_t index) {
+  return seed * 1000003ULL + index;
+}
+
 class SequenceGenerator {
  public:
   struct Params {
