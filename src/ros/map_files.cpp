@@ -1,5 +1,7 @@
 #include "quadric_slam/ros/map_files.h"
 
+#include "quadric_slam/io/pcd_header.h"
+
 #include <pcl/PCLPointCloud2.h>
 #include <pcl/conversions.h>
 #include <pcl/io/pcd_io.h>
@@ -78,6 +80,15 @@ LoadedMap loadMapFiles(const std::string& map_path) {
   const std::string pcd_path = reconstructionPathFor(map_path);
   if (!fs::exists(pcd_path))
     return loaded;
+  // PCL trusts the header; a damaged file is refused before PCL reads it (io/pcd_header.h).
+  const PcdHeader header = checkPcdFile(pcd_path);
+  for (const char* axis : {"x", "y", "z"}) {
+    bool float_axis = false;
+    for (std::size_t i = 0; i < header.fields.size(); ++i)
+      float_axis = float_axis || (header.fields[i] == axis && header.types[i] == 'F');
+    if (!float_axis)
+      throw std::runtime_error(pcd_path + ": no float field '" + axis + "'");
+  }
   pcl::PCLPointCloud2 cloud;
   if (pcl::io::loadPCDFile(pcd_path, cloud) != 0)
     throw std::runtime_error("cannot read the reconstruction " + pcd_path);

@@ -6,12 +6,17 @@
 #include <gtest/gtest.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
+#include <sstream>
 #include <stdexcept>
+#include <typeinfo>
 
+#include "../fuzz_mutations.h"
 #include "quadric_slam/geometry/shapes.h"
 #include "quadric_slam/geometry/surface_distance.h"
 #include "quadric_slam/ros/map_files.h"
@@ -180,6 +185,71 @@ TEST_F(MapFilesTest, WhatCannotBeLoadedIsRefusedNamingTheFile) {
                                       "COUNT 1 1 1\nWIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\n"
                                       "POINTS 1\nDATA ascii\n0 0 0\n";
   EXPECT_THROW(qs::loadMapFiles(good), std::runtime_error);
+}
+
+std::string fileBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  return bytes.str();
+}
+
+// Seeded fuzzing of a saved map (issue 14): the YAML and the binary PCD beside it, mutated a few
+// bytes at a time. Every case must either be refused with std::runtime_error (the documented
+// error) or load landmarks the mapper can use: finite poses, positive finite scales, ids >= 1,
+// reconstruction points with finite coordinates and a known label. No other exception, no crash.
+TEST_F(MapFilesTest, FuzzedMapFilesAreRefusedOrLoadValidLandmarks) {
+  const std::vector<qs::QuadricLandmark> landmarks = everyClass();
+  std_msgs::Header header;
+  header.frame_id = "map";
+  const fs::path original = dir_ / "original.yaml";
+  qs::saveMapFiles(original.string(), landmarks, "map",
+                   qs::reconstructionCloudMsg(surfacePoints(landmarks), header));
+  const std::string yaml = fileBytes(original), pcd = fileBytes(dir_ / "original.pcd");
+  ASSERT_FALSE(yaml.empty());
+  ASSERT_FALSE(pcd.empty());
+
+  const int kCases = qs::test::fuzzCases(1500);
+  int refused = 0, loaded_cases = 0;
+  std::map<std::string, int> reasons;
+  qs::test::FuzzMutator mutator(20261201);
+  for (int k = 0; k < kCases; ++k) {
+    // Two cases in three mutate the YAML, one in three the PCD (with the original YAML).
+    const bool mutate_yaml = k % 3 != 2;
+    const fs::path path = dir_ / ("case" + std::to_string(k) + ".yaml");
+    std::ofstream(path, std::ios::binary) << (mutate_yaml ? mutator.mutate(yaml) : yaml);
+    std::ofstream(dir_ / ("case" + std::to_string(k) + ".pcd"), std::ios::binary)
+        << (mutate_yaml ? pcd : mutator.mutate(pcd));
+    try {
+      const qs::LoadedMap map = qs::loadMapFiles(path.string());
+      ++loaded_cases;
+      std::set<int> ids;
+      for (const qs::QuadricLandmark& l : map.landmarks) {
+        ids.insert(l.id);
+        EXPECT_GE(l.id, 1) << "case " << k;
+        EXPECT_TRUE(l.quadric_map.pose().matrix().allFinite()) << "case " << k;
+        EXPECT_TRUE(l.quadric_map.scale().allFinite() && (l.quadric_map.scale().array() > 0).all())
+            << "case " << k << ": scale " << l.quadric_map.scale().transpose();
+      }
+      for (const pcl::PointXYZL& p : map.reconstruction) {
+        EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << "case " << k;
+        EXPECT_TRUE(ids.count(static_cast<int>(p.label))) << "case " << k;
+      }
+    } catch (const std::runtime_error& e) {
+      ++refused;
+      const std::string what = e.what();
+      ++reasons[what.substr(
+          0, std::min<std::size_t>(what.find(':') == std::string::npos ? 40 : what.find(':'), 40))];
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "case " << k << ": " << typeid(e).name() << ": " << e.what();
+    }
+    fs::remove(path);
+    fs::remove(dir_ / ("case" + std::to_string(k) + ".pcd"));
+  }
+  std::printf("fuzzed map files: %d cases, %d loaded, %d refused with std::runtime_error\n", kCases,
+              loaded_cases, refused);
+  EXPECT_GT(refused, kCases / 10) << "the mutations hardly ever break the files";
+  EXPECT_GT(loaded_cases, 0);
 }
 
 TEST(ReconstructionCloud, FieldsAndLandmarkColours) {
