@@ -104,6 +104,20 @@ cv::Mat colourToRgb(const sensor_msgs::Image& image, const std::string& topic) {
   return rgb;
 }
 
+// rosbag and roscpp's deserialisation throw without the file's name (ros::Exception "Buffer
+// Overrun", "Error parsing header", std::bad_alloc for a corrupted length): every error of the
+// reader becomes a std::runtime_error that names the bag. Call from a catch block.
+[[noreturn]] void rethrowNamingTheBag(const std::string& bag_path) {
+  try {
+    throw;
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    if (what.rfind(bag_path, 0) == 0)
+      throw std::runtime_error(what);
+    throw std::runtime_error(bag_path + ": " + what);
+  }
+}
+
 }  // namespace
 
 struct TumBagReader::Impl {
@@ -114,6 +128,7 @@ struct TumBagReader::Impl {
   };
 
   Params params;
+  std::string path;
   rosbag::Bag bag;
   std::vector<rosbag::MessageInstance> depth_messages, rgb_messages;
   std::vector<double> rgb_stamps;
@@ -135,8 +150,17 @@ void TumBagReader::Params::validate() const {
 TumBagReader::TumBagReader(const std::string& bag_path, const Params& params)
     : impl_(std::make_unique<Impl>()) {
   params.validate();
+  try {
+    open(bag_path, params);
+  } catch (...) {
+    rethrowNamingTheBag(bag_path);
+  }
+}
+
+void TumBagReader::open(const std::string& bag_path, const Params& params) {
   Impl& d = *impl_;
   d.params = params;
+  d.path = bag_path;
   try {
     d.bag.open(bag_path, rosbag::bagmode::Read);
   } catch (const rosbag::BagException& e) {
@@ -225,6 +249,14 @@ const CameraIntrinsics& TumBagReader::intrinsics() const {
 }
 
 bool TumBagReader::next(RgbdFrame& frame) {
+  try {
+    return readNext(frame);
+  } catch (...) {
+    rethrowNamingTheBag(impl_->path);
+  }
+}
+
+bool TumBagReader::readNext(RgbdFrame& frame) {
   Impl& d = *impl_;
   if (d.position >= d.entries.size())
     return false;

@@ -239,7 +239,8 @@ int main(int argc, char** argv) {
                   << ',' << qs::residentMemoryBytes() / 1048576.0 << ','
                   << std::chrono::duration<double, std::milli>(now - last_sample).count() /
                          in_interval
-                  << ',' << slam.mapper().map().landmarks().size() << '\n';
+                  << ',' << slam.mapper().map().landmarks().size()
+                  << std::endl;  // flushed: the curve can be watched during a long run
         last_sample = now;
       }
       if (!o.quiet && (frames % 30 == 0 || frames == total)) {

@@ -45,6 +45,10 @@ class TumBagReader : public FrameSource {
   const CameraIntrinsics& intrinsics() const;
 
  private:
+  // The constructor's and next()'s work; their callers make every error name the bag.
+  void open(const std::string& bag_path, const Params& params);
+  bool readNext(RgbdFrame& frame);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

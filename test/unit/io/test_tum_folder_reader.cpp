@@ -4,14 +4,18 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
+#include "../fuzz_mutations.h"
+#include "../test_data.h"
 #include "quadric_slam/io/depth_png.h"
 #include "quadric_slam/io/tum_folder_reader.h"
-#include "../test_data.h"
 
 namespace fs = std::filesystem;
 using quadric_slam::RgbdFrame;
@@ -136,9 +140,8 @@ TEST(TumFolderReader, DepthPngReadsMetresWithNanForNoData) {
   const cv::Mat fr2 = quadric_slam::readTumDepthPng(path, 5208.0);
   EXPECT_FLOAT_EQ(stats(fr2).median, static_cast<float>(all.median * 5000.0 / 5208.0));
 
-  EXPECT_THROW(
-      quadric_slam::readTumDepthPng(kFrames + "fr1_xyz/1305031102.175304.png"),
-      std::runtime_error);  // an RGB image
+  EXPECT_THROW(quadric_slam::readTumDepthPng(kFrames + "fr1_xyz/1305031102.175304.png"),
+               std::runtime_error);  // an RGB image
   EXPECT_THROW(quadric_slam::readTumDepthPng("/nonexistent.png"), std::runtime_error);
   EXPECT_THROW(quadric_slam::depthUnitsToMetres(raw, 0.0), std::invalid_argument);
 }
@@ -246,4 +249,60 @@ TEST(TumFolderReader, BadFoldersAndParamsNameTheProblem) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("max_rgb_difference"), std::string::npos);
   }
+}
+
+// Seeded fuzzing of a TUM folder (issue 14): depth.txt, rgb.txt, a depth PNG or an RGB PNG mutated
+// a few bytes at a time. Opening the folder and reading every frame must either stop with
+// std::runtime_error naming the file, or give frames a pipeline can use: 32FC1 depth of the
+// intrinsics' size with finite positive metres or NaN, stamps finite. No other exception, no crash.
+TEST(TumFolderReader, FuzzedFoldersAreRefusedOrGiveValidFrames) {
+  const fs::path root = makeFr1Folder();
+  const std::vector<fs::path> targets = {root / "depth.txt", root / "rgb.txt",
+                                         root / "depth" / "1305031102.160407.png",
+                                         root / "rgb" / "1305031102.175304.png"};
+  std::vector<std::string> originals;
+  for (const fs::path& target : targets) {
+    std::ifstream in(target, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    originals.push_back(bytes.str());
+  }
+  const int cases = quadric_slam::test::fuzzCases(240);
+  int refused = 0, read_through = 0;
+  quadric_slam::test::FuzzMutator mutator(7);
+  for (int k = 0; k < cases; ++k) {
+    const std::size_t t = static_cast<std::size_t>(k) % targets.size();
+    std::ofstream(targets[t], std::ios::binary) << mutator.mutate(originals[t]);
+    try {
+      TumFolderReader reader(root.string());
+      RgbdFrame frame;
+      while (reader.next(frame)) {
+        ASSERT_EQ(frame.depth_m.type(), CV_32FC1) << "case " << k;
+        EXPECT_EQ(frame.depth_m.cols, frame.intrinsics.width) << "case " << k;
+        EXPECT_EQ(frame.depth_m.rows, frame.intrinsics.height) << "case " << k;
+        EXPECT_TRUE(std::isfinite(frame.stamp)) << "case " << k;
+        int bad = 0;
+        for (int v = 0; v < frame.depth_m.rows; ++v)
+          for (int u = 0; u < frame.depth_m.cols; ++u) {
+            const float z = frame.depth_m.at<float>(v, u);
+            bad += !(std::isnan(z) || (std::isfinite(z) && z > 0));
+          }
+        EXPECT_EQ(bad, 0) << "case " << k << ": depth values neither NaN nor positive metres";
+        if (!frame.rgb.empty()) {
+          EXPECT_EQ(frame.rgb.type(), CV_8UC3) << "case " << k;
+        }
+      }
+      ++read_through;
+    } catch (const std::runtime_error& e) {
+      ++refused;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "case " << k << " (" << targets[t].filename() << "): " << typeid(e).name()
+                    << ": " << e.what();
+    }
+    std::ofstream(targets[t], std::ios::binary) << originals[t];
+  }
+  std::printf("fuzzed TUM folders: %d cases, %d read through, %d refused with std::runtime_error\n",
+              cases, read_through, refused);
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(read_through, 0);
 }

@@ -6,11 +6,15 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
+#include "../fuzz_mutations.h"
 #include "quadric_slam/ros/tum_bag_reader.h"
 
 using quadric_slam::RgbdFrame;
@@ -188,4 +192,53 @@ TEST(TumBagReader, MissingCameraInfoOrBadEncodingIsAClearError) {
   }
   std::remove(bad.c_str());
   EXPECT_THROW(TumBagReader("/nonexistent/file.bag"), std::runtime_error);
+}
+
+// Seeded fuzzing of a TUM bag (issue 14): the bag file mutated a few bytes at a time (headers,
+// chunk sizes, index records and message bytes alike). Opening it and reading every frame must
+// either stop with std::runtime_error naming the bag, or give frames a pipeline can use. No other
+// exception, no crash.
+TEST(TumBagReader, FuzzedBagsAreRefusedOrGiveValidFrames) {
+  const std::string path = writeBag("tum_bag_reader_fuzz_original.bag", true);
+  std::string original;
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    original = bytes.str();
+  }
+  const std::string mutated_path = ::testing::TempDir() + "/tum_bag_reader_fuzz_case.bag";
+  const int cases = quadric_slam::test::fuzzCases(300);
+  int refused = 0, read_through = 0;
+  quadric_slam::test::FuzzMutator mutator(11);
+  for (int k = 0; k < cases; ++k) {
+    std::ofstream(mutated_path, std::ios::binary | std::ios::trunc) << mutator.mutate(original);
+    try {
+      TumBagReader reader(mutated_path);
+      RgbdFrame frame;
+      while (reader.next(frame)) {
+        ASSERT_EQ(frame.depth_m.type(), CV_32FC1) << "case " << k;
+        EXPECT_EQ(frame.depth_m.cols, frame.intrinsics.width) << "case " << k;
+        EXPECT_EQ(frame.depth_m.rows, frame.intrinsics.height) << "case " << k;
+        EXPECT_TRUE(std::isfinite(frame.stamp)) << "case " << k;
+        for (int v = 0; v < frame.depth_m.rows; ++v)
+          for (int u = 0; u < frame.depth_m.cols; ++u) {
+            const float z = frame.depth_m.at<float>(v, u);
+            EXPECT_TRUE(std::isnan(z) || (std::isfinite(z) && z > 0))
+                << "case " << k << ": depth " << z << " at " << u << ", " << v;
+          }
+      }
+      ++read_through;
+    } catch (const std::runtime_error& e) {
+      ++refused;
+      EXPECT_NE(std::string(e.what()).find("tum_bag_reader_fuzz_case.bag"), std::string::npos)
+          << "case " << k << ": " << e.what();
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "case " << k << ": " << typeid(e).name() << ": " << e.what();
+    }
+  }
+  std::printf("fuzzed TUM bags: %d cases, %d read through, %d refused with std::runtime_error\n",
+              cases, read_through, refused);
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(read_through, 0);
 }
