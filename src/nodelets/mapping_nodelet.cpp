@@ -27,8 +27,10 @@
 // non-finite or negative covariance, an odom frame other than ~odom_frame or a repeated stamp is
 // dropped; an observation that does not convert (bad class, pose, scale, covariance size) or that
 // the mapper refuses is dropped, the rest of the frame is used. Each gets a throttled error naming
-// the problem and is counted on /diagnostics. No callback lets an exception escape (it would take
-// the whole manager down).
+// the problem and is counted on /diagnostics. A frame whose odometry says tracking is lost
+// (ros/odometry_status.h) adds nothing to the map; after it the mapper localises only until the
+// surfaces anchor the pose in the map again (mapping/tracking_recovery.h; on /diagnostics). No
+// callback lets an exception escape (it would take the whole manager down).
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
@@ -56,16 +58,18 @@
 #include "quadric_slam/LoadMap.h"
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/SaveMap.h"
+#include "quadric_slam/eval/recent_durations.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
+#include "quadric_slam/mapping/tracking_recovery.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
-#include "quadric_slam/eval/recent_durations.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/diagnostics.h"
-#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/drop_reporter.h"
+#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/map_files.h"
 #include "quadric_slam/ros/map_publisher.h"
+#include "quadric_slam/ros/odometry_status.h"
 #include "quadric_slam/ros/params.h"
 #include "quadric_slam/ros/reconstruction_cloud.h"
 
@@ -128,6 +132,7 @@ class MappingNodelet : public nodelet::Nodelet {
     ParamLog log;
     QuadricMapper::Params mapper_params;
     QuadricReconstruction::Params reconstruction_params;
+    TrackingRecovery::Params recovery_params;
     int queue_size = 10;
     double diagnostic_period = 1.0;
     bool localization_only = false;
@@ -143,6 +148,7 @@ class MappingNodelet : public nodelet::Nodelet {
       readParam(reader, "localization_only", localization_only, log);
       readParam(reader, "diagnostic_period", diagnostic_period, log);
       readMappingParams(reader, mapper_params, reconstruction_params, log);
+      readTrackingRecoveryParams(reader, recovery_params, log);
       if (map_frame_.empty() || odom_frame_.empty() || map_frame_ == odom_frame_)
         throw std::invalid_argument("map_frame and odom_frame must be non-empty and differ");
       if (queue_size < 1)
@@ -156,6 +162,8 @@ class MappingNodelet : public nodelet::Nodelet {
       mapper_ = std::make_unique<QuadricMapper>(mapper_params);
       reconstruction_ = std::make_unique<QuadricReconstruction>(reconstruction_params);
       mapper_->setLocalizationOnly(localization_only);
+      user_localization_only_ = localization_only;
+      recovery_ = TrackingRecovery(recovery_params);
     } catch (const std::invalid_argument& e) {
       NODELET_FATAL("mapping: invalid parameter: %s", e.what());
       throw;
@@ -276,6 +284,18 @@ class MappingNodelet : public nodelet::Nodelet {
       return;
     }
     checkObservationFrame(observations.header.frame_id, odom.child_frame_id);
+    if (isLost(odom)) {
+      // The odometry lost track: its pose is the last one before the loss, not this frame's.
+      // Nothing of the frame reaches the map; afterwards the mapper localises until the surfaces
+      // anchor the pose again (mapping/tracking_recovery.h).
+      recovery_.trackingLost(static_cast<int>(mapper_->map().landmarks().size()));
+      std::lock_guard<std::mutex> lock(stats_mutex_);
+      ++stats_.frames_lost;
+      return;
+    }
+    const bool localise_only = user_localization_only_ || recovery_.recovering();
+    if (mapper_->localizationOnly() != localise_only)
+      mapper_->setLocalizationOnly(localise_only);
     OdometryInput odometry;
     odometry.T_odom_camera = fromPoseMsg(odom.pose.pose);
     // The odometry's covariance is cumulative since its start: like QuadricSlam, the mapper uses
@@ -308,6 +328,7 @@ class MappingNodelet : public nodelet::Nodelet {
     have_stamp_ = true;
     last_stamp_ = stamp;
     T_map_odom_ = result.T_map_odom;
+    recovery_.frameMapped(landmarkAssociations(result.update));
     if (result.rejected_measurements > 0)
       observation_drops_.report("the mapper refused: " + result.message);
 
@@ -366,7 +387,8 @@ class MappingNodelet : public nodelet::Nodelet {
       stats_.solve_ms = 1e3 * result.optimisation_seconds;
     }
     stats_.processing_times.add(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
   }
 
   // The observations are used in the frame whose pose odom gives (its child frame). Another frame
@@ -392,6 +414,8 @@ class MappingNodelet : public nodelet::Nodelet {
   // Forgets the map (back to the loaded one, if any), the reconstruction and the path.
   void reset() {
     mapper_->reset();
+    recovery_.reset();
+    mapper_->setLocalizationOnly(user_localization_only_);
     reconstruction_->clear();
     path_.clear();
     keyframes_ = 0;
@@ -439,6 +463,8 @@ class MappingNodelet : public nodelet::Nodelet {
       return false;
     }
     mapper_->setLocalizationOnly(localization_only);
+    user_localization_only_ = localization_only;
+    recovery_.reset();
     const std::size_t points = base->map.reconstruction.size();
     *message = "loaded " + std::to_string(base->map.landmarks.size()) + " quadrics from " + path +
                (base->map.reconstruction_path.empty()
@@ -570,6 +596,8 @@ class MappingNodelet : public nodelet::Nodelet {
   struct Stats {
     long observation_messages = 0, odom_messages = 0, synchronised = 0;
     long frames_processed = 0, frames_dropped = 0, keyframes = 0, resets = 0;
+    long frames_lost = 0;  // odometry lost track: nothing of the frame reached the map
+    int losses = 0, recoveries = 0, recovery_timeouts = 0;
     long observations = 0, observations_dropped = 0, total_to_landmarks = 0, total_promoted = 0;
     std::string last_drop_reason, last_observation_problem;
     FrameStats last;
@@ -579,8 +607,8 @@ class MappingNodelet : public nodelet::Nodelet {
     std::map<std::string, int> landmarks_per_class;
     int landmarks = 0, candidates = 0;
     std::string observation_frame, camera_frame;  // of the latest frame (observations, odom child)
-    std::string mode = "mapping";  // or "localisation only"
-    std::string loaded_from;       // the loaded map file, if any
+    std::string mode = "mapping";                 // or "localisation only"
+    std::string loaded_from;                      // the loaded map file, if any
     // At the previous report.
     long reported_processed = 0, reported_dropped = 0, reported_observations_dropped = 0;
   };
@@ -596,7 +624,13 @@ class MappingNodelet : public nodelet::Nodelet {
     stats_.landmarks_per_class = per_class;
     stats_.landmarks = static_cast<int>(mapper_->map().landmarks().size());
     stats_.candidates = static_cast<int>(mapper_->map().candidates().size());
-    stats_.mode = mapper_->localizationOnly() ? "localisation only" : "mapping";
+    stats_.mode = recovery_.recovering() && !user_localization_only_
+                      ? "relocalising after a loss of tracking (localisation only)"
+                  : mapper_->localizationOnly() ? "localisation only"
+                                                : "mapping";
+    stats_.losses = recovery_.losses();
+    stats_.recoveries = recovery_.recoveries();
+    stats_.recovery_timeouts = recovery_.timeouts();
     stats_.loaded_from = loaded_from_;
   }
 
@@ -642,6 +676,10 @@ class MappingNodelet : public nodelet::Nodelet {
     status.add("last drop reason", s.last_drop_reason);
     status.add("keyframes", s.keyframes);
     status.add("resets (time went backwards)", s.resets);
+    status.add("frames while tracking was lost", s.frames_lost);
+    status.add("tracking losses", s.losses);
+    status.add("recoveries (pose anchored in the map again)", s.recoveries);
+    status.add("recoveries given up (recovery_max_frames)", s.recovery_timeouts);
     status.add("observations received", s.observations);
     status.add("observations dropped", s.observations_dropped);
     status.add("last observation problem", s.last_observation_problem);
@@ -678,7 +716,9 @@ class MappingNodelet : public nodelet::Nodelet {
   std::mutex mutex_;
   std::unique_ptr<QuadricMapper> mapper_;
   std::unique_ptr<QuadricReconstruction> reconstruction_;
-  std::unique_ptr<BaseMap> base_map_;  // the loaded map a reset returns to
+  TrackingRecovery recovery_;
+  bool user_localization_only_ = false;  // ~localization_only or the last ~load_map request
+  std::unique_ptr<BaseMap> base_map_;    // the loaded map a reset returns to
   std::string loaded_from_;
   bool have_stamp_ = false;
   ros::Time last_stamp_;

@@ -9,7 +9,9 @@
 //             QuadricSegmentation, only when ~use_observations: paired with points_normals by
 //             exact stamp, they give the tracker its motion guess for large steps, as in the
 //             offline runner)
-// Publishes   odom (nav_msgs/Odometry: pose of ~camera_frame in ~odom_frame with covariance)
+// Publishes   odom (nav_msgs/Odometry: pose of ~camera_frame in ~odom_frame with covariance;
+//             while tracking is lost, the last pose with every pose variance 9999: ros/
+//             odometry_status.h)
 //             tf ~odom_frame -> ~camera_frame (when ~publish_tf)
 //             /diagnostics (frames processed and dropped per reason, processing time, output
 //             rate: ros/diagnostics.h; and "<name> tracking": ok / degenerate / lost with the ICP
@@ -20,12 +22,12 @@
 // A cloud or camera_info it cannot use (see ros/message_validation.h), or a cloud that makes the
 // core throw, gets an error, throttled per reason; dropped clouds are counted on /diagnostics.
 #include <geometry_msgs/TransformStamped.h>
+#include <message_filters/subscriber.h>
+#include <message_filters/time_synchronizer.h>
 #include <nav_msgs/Odometry.h>
 #include <nodelet/nodelet.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
-#include <message_filters/subscriber.h>
-#include <message_filters/time_synchronizer.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -40,14 +42,15 @@
 #include <string>
 
 #include "quadric_slam/QuadricObservationArray.h"
-#include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
+#include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
-#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/drop_reporter.h"
+#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/message_validation.h"
+#include "quadric_slam/ros/odometry_status.h"
 #include "quadric_slam/ros/params.h"
 #include "quadric_slam/ros/points_normals.h"
 
@@ -224,6 +227,8 @@ class OdometryNodelet : public nodelet::Nodelet {
       for (int c = 0; c < 6; ++c)
         odom->pose.covariance[6 * r + c] = result.covariance(r, c);
     }
+    if (result.status == TrackingStatus::kLost)
+      markLost(*odom);  // the last pose, flagged (ros/odometry_status.h)
     // Twist: finite difference of the last two poses, in the camera (child) frame. Its
     // covariance is not estimated: a large diagonal says so.
     const double dt = (stamp - last_pose_stamp_).toSec();

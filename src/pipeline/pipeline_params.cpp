@@ -95,4 +95,13 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
   reconstruction.validate();
 }
 
+void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Params& params,
+                                ParamLog& log) {
+  readParam(reader, "recovery_min_landmark_associations", params.min_landmark_associations, log);
+  readParam(reader, "recovery_confirm_frames", params.confirm_frames, log);
+  readParam(reader, "recovery_min_map_landmarks", params.min_map_landmarks, log);
+  readParam(reader, "recovery_max_frames", params.max_frames, log);
+  params.validate();
+}
+
 }  // namespace quadric_slam

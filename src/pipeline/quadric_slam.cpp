@@ -17,6 +17,7 @@ void SlamParams::validate() const {
   odometry.validate();
   mapping.validate();
   reconstruction.validate();
+  recovery.validate();
   if (max_support_points < 0)
     throw std::invalid_argument("max_support_points must be >= 0, got " +
                                 std::to_string(max_support_points));
@@ -37,7 +38,9 @@ SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log) {
   readSegmentationParams(segmentation, params.segmentation, effective);
   readParam(segmentation, "max_support_points", params.max_support_points, effective);
   readOdometryParams(reader("odometry.yaml"), params.odometry, effective);
-  readMappingParams(reader("mapping.yaml"), params.mapping, params.reconstruction, effective);
+  const YamlParamReader mapping = reader("mapping.yaml");
+  readMappingParams(mapping, params.mapping, params.reconstruction, effective);
+  readTrackingRecoveryParams(mapping, params.recovery, effective);
   params.validate();
   return params;
 }
@@ -48,12 +51,15 @@ QuadricSlam::QuadricSlam(const SlamParams& params)
       segmenter_(params.segmentation),
       odometry_(params.odometry),
       mapper_(params.mapping),
-      reconstruction_(params.reconstruction) {}
+      reconstruction_(params.reconstruction),
+      recovery_(params.recovery) {}
 
 void QuadricSlam::reset() {
   odometry_.reset();
   mapper_.reset();
   reconstruction_.clear();
+  recovery_.reset();
+  mapper_.setLocalizationOnly(false);
   has_stamp_ = false;
 }
 
@@ -100,11 +106,24 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
   if (!params_.mapping_enabled || !out.tracking)
     return out;
 
+  if (out.odometry.status == TrackingStatus::kLost) {
+    // The pose is the last one before the loss, not this frame's: nothing of it reaches the map.
+    recovery_.trackingLost(static_cast<int>(mapper_.map().landmarks().size()));
+    out.recovering = recovery_.recovering();
+    out.message = "tracking lost: the mapper adds nothing from this frame";
+    return out;
+  }
+  if (mapper_.localizationOnly() != recovery_.recovering())
+    mapper_.setLocalizationOnly(recovery_.recovering());
+  out.recovering = recovery_.recovering();
+
   OdometryInput odometry_input;
   odometry_input.T_odom_camera = out.odometry.T_odom_camera;
   out.mapping =
       timer_.time("mapping", [&] { return mapper_.process(out.measurements, odometry_input); });
   out.mapped = out.mapping.status == FrameStatus::kOk;
+  if (out.mapped)
+    recovery_.frameMapped(landmarkAssociations(out.mapping.update));
   if (!out.mapped) {
     out.message = "mapper refused the frame: " + out.mapping.message;
     return out;

@@ -207,6 +207,7 @@ int main(int argc, char** argv) {
     qs::StageTimer read_timer;
     qs::Trajectory odom_trajectory, map_trajectory;
     int status_counts[3] = {0, 0, 0};
+    std::size_t frames_recovering = 0;  // the mapper localised only (after a loss of tracking)
     std::map<std::string, std::size_t> observations_per_class;
     std::size_t frames = 0, skipped = 0;
     const auto start = std::chrono::steady_clock::now();
@@ -224,6 +225,7 @@ int main(int argc, char** argv) {
       for (const qs::QuadricMeasurement& m : result.measurements.observations)
         ++observations_per_class[qs::toString(m.quadric_camera.quadricClass())];
       ++status_counts[static_cast<int>(result.odometry.status)];
+      frames_recovering += result.recovering ? 1 : 0;
       if (result.tracking)
         odom_trajectory.push_back({frame.stamp, result.odometry.T_odom_camera});
       if (result.mapped)
@@ -271,6 +273,11 @@ int main(int argc, char** argv) {
     std::printf("tracking ok %d degenerate %d lost %d\n", status_counts[0], status_counts[1],
                 status_counts[2]);
     if (!o.odometry_only) {
+      std::printf(
+          "mapping after losses: lost %d times, recovered %d, gave up %d, frames localising only "
+          "%zu\n",
+          slam.recovery().losses(), slam.recovery().recoveries(), slam.recovery().timeouts(),
+          frames_recovering);
       std::printf("observations per frame:");
       for (const auto& [name, count] : observations_per_class)
         std::printf(" %s %.2f", name.c_str(),

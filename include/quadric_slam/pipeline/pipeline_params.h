@@ -9,6 +9,7 @@
 #include "quadric_slam/io/param_reader.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
+#include "quadric_slam/mapping/tracking_recovery.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
 
 namespace quadric_slam {
@@ -32,5 +33,10 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
 // meaning, unit and default, in config/mapping.yaml.
 void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
                        QuadricReconstruction::Params& reconstruction, ParamLog& log);
+
+// config/mapping.yaml, what the map does after a loss of tracking (mapping/tracking_recovery.h):
+// recovery_min_landmark_associations, recovery_confirm_frames, recovery_min_map_landmarks, recovery_max_frames.
+void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Params& params,
+                                ParamLog& log);
 
 }  // namespace quadric_slam

@@ -11,7 +11,9 @@
 //   4. quadric segmentation (frontend/quadric_segmenter.h), unless odometry only;
 //   5. odometry (odometry/odometry_tracker.h);
 //   6. mapping (mapping/quadric_mapper.h) once odometry is initialised, and on keyframes the
-//      supporting points of the landmark observations into the reconstruction.
+//      supporting points of the landmark observations into the reconstruction. A frame whose
+//      odometry is lost reaches no mapper; after a loss the mapper localises only until the
+//      surfaces anchor the pose in the map again (mapping/tracking_recovery.h).
 // Every stage is timed under its name (timer()): normals, segmentation, odometry, mapping,
 // reconstruction.
 #pragma once
@@ -30,6 +32,7 @@
 #include "quadric_slam/io/param_reader.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
+#include "quadric_slam/mapping/tracking_recovery.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
 #include "quadric_slam/types/observation.h"
 
@@ -42,6 +45,7 @@ struct SlamParams {
   OdometryTracker::Params odometry;
   QuadricMapper::Params mapping;
   QuadricReconstruction::Params reconstruction;
+  TrackingRecovery::Params recovery;
   // Supporting points each observation carries to the mapper (segmentation.yaml
   // max_support_points; frontend/detection_measurement.h), >= 0.
   int max_support_points = 1000;
@@ -64,9 +68,12 @@ struct SlamFrameResult {
   bool processed = false;  // false: skipped (message says why), nothing changed
   std::string message;     // why the frame was skipped, or what a stage refused
   OdometryTracker::Result odometry;
-  bool tracking = false;  // odometry is initialised (odometry.T_odom_camera is meaningful)
+  bool tracking = false;           // odometry is initialised (odometry.T_odom_camera is meaningful)
   FrameMeasurements measurements;  // the segmentation's observations (camera frame)
   bool mapped = false;             // the mapper accepted the frame (mapping is meaningful)
+  // The mapper localised only (after a loss of tracking; nothing was added to the map). Also true
+  // for a lost frame while the map still waits to be anchored.
+  bool recovering = false;
   MapperFrameResult mapping;
 };
 
@@ -83,6 +90,7 @@ class QuadricSlam {
   const QuadricMapper& mapper() const { return mapper_; }
   const OdometryTracker& odometry() const { return odometry_; }
   const QuadricReconstruction& reconstruction() const { return reconstruction_; }
+  const TrackingRecovery& recovery() const { return recovery_; }
   // The landmarks' points on their current surfaces, label = landmark id.
   pcl::PointCloud<pcl::PointXYZL> reconstructionCloud() const;
   // The latest frame's organized cloud with normals, and its segmentation (labels per point).
@@ -99,6 +107,7 @@ class QuadricSlam {
   OdometryTracker odometry_;
   QuadricMapper mapper_;
   QuadricReconstruction reconstruction_;
+  TrackingRecovery recovery_;
   StageTimer timer_;
   bool has_stamp_ = false;
   double last_stamp_ = 0.0;

@@ -82,3 +82,34 @@ TEST(PipelineParams, OdometryYamlKeysAreAllRead) {
   EXPECT_EQ(params.quadric_motion_guess, file["quadric_motion_guess"].as<bool>());
   EXPECT_EQ(params.guess.max_direction_features, file["guess_max_direction_features"].as<int>());
 }
+
+TEST(PipelineParams, MappingYamlKeysAreAllRead) {
+  const YAML::Node file = YAML::LoadFile(kConfigDir + "mapping.yaml");
+  const qs::YamlParamReader reader(file);
+  qs::QuadricMapper::Params mapper;
+  qs::QuadricReconstruction::Params reconstruction;
+  qs::TrackingRecovery::Params recovery;
+  qs::ParamLog log;
+  qs::readMappingParams(reader, mapper, reconstruction, log);
+  qs::readTrackingRecoveryParams(reader, recovery, log);
+  // Nodelet-level keys, read beside the tables.
+  std::string text;
+  bool flag = false;
+  int count = 0;
+  double period = 1.0;
+  for (const char* key : {"map_frame", "odom_frame", "map_file"})
+    qs::readParam(reader, key, text, log);
+  for (const char* key : {"publish_tf", "localization_only"})
+    qs::readParam(reader, key, flag, log);
+  for (const char* key : {"queue_size", "reconstruction_every_keyframes", "max_path_poses"})
+    qs::readParam(reader, key, count, log);
+  qs::readParam(reader, "diagnostic_period", period, log);
+  for (const auto& entry : file) {
+    const std::string key = entry.first.as<std::string>();
+    EXPECT_NE(log.str().find("\n  " + key + ": "), std::string::npos)
+        << "config/mapping.yaml key '" << key << "' is read by nobody";
+  }
+  EXPECT_EQ(recovery.confirm_frames, file["recovery_confirm_frames"].as<int>());
+  EXPECT_EQ(recovery.min_landmark_associations,
+            file["recovery_min_landmark_associations"].as<int>());
+}

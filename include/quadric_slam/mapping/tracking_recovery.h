@@ -1,0 +1,65 @@
+// What the map does after the odometry has lost track. The odometry starts again from its last
+// pose once it has a new keyframe, but the camera may have moved meanwhile (a covered lens, a gap
+// in a bag, a view of a blank wall): its pose in the map is then unknown, and surfaces seen from it
+// would enter the map in the wrong place. So after a loss the mapper only localises: it associates
+// the frame's surfaces with the landmarks it already has (nothing new is promoted, landmarks are
+// held fixed) until enough of them agree, in enough consecutive frames, that the pose is anchored
+// in the map again; then mapping resumes. With too few landmarks to anchor against, mapping
+// resumes at once (there is nothing to put out of place). Without relocalisation against the map
+// (the camera lost far from where it was), it waits until the view returns, unless max_frames
+// lets it give up.
+#pragma once
+
+#include "quadric_slam/mapping/landmark_registry.h"
+
+namespace quadric_slam {
+
+// How many of a frame's measurements associated with map landmarks.
+int landmarkAssociations(const MapUpdate& update);
+
+class TrackingRecovery {
+ public:
+  struct Params {
+    // A frame anchors the pose when at least this many of its observations associate with map
+    // landmarks, [1, 100]. Default 3 (a pose has six degrees of freedom; a plane fixes three).
+    int min_landmark_associations = 3;
+    // Consecutive anchoring frames before mapping resumes, [1, 1000]. Default 3.
+    int confirm_frames = 3;
+    // Mapping resumes at once after a loss when the map holds fewer landmarks than this, [0, inf).
+    int min_map_landmarks = 3;
+    // Mapping resumes anyway after this many localising frames without an anchor, [0, inf); 0
+    // (the default) waits until the view returns to mapped surfaces. Resuming without an anchor
+    // lets the map continue from the odometry's pose, so surfaces seen again may be mapped twice.
+    int max_frames = 0;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  TrackingRecovery() : TrackingRecovery(Params{}) {}
+  explicit TrackingRecovery(const Params& params);
+
+  // The odometry lost track in this frame (nothing of the frame reaches the mapper).
+  void trackingLost(int map_landmarks);
+  // A frame the mapper has processed (localisation only while recovering): how many of its
+  // observations associated with landmarks.
+  void frameMapped(int landmark_associations);
+  // True while the pose is not anchored in the map again: the mapper must localise only.
+  bool recovering() const { return recovering_; }
+  // Losses since the start, recoveries completed, and recoveries given up after max_frames.
+  int losses() const { return losses_; }
+  int recoveries() const { return recoveries_; }
+  int timeouts() const { return timeouts_; }
+  void reset();
+
+  const Params& params() const { return params_; }
+
+ private:
+  Params params_;
+  bool recovering_ = false;
+  int anchored_frames_ = 0;
+  int recovering_frames_ = 0;
+  int losses_ = 0, recoveries_ = 0, timeouts_ = 0;
+};
+
+}  // namespace quadric_slam

@@ -1,0 +1,91 @@
+// What the map does after a loss of tracking (mapping/tracking_recovery.h): localisation only until
+// enough consecutive frames anchor the pose on the map's landmarks; nothing to wait for with an
+// (almost) empty map.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+#include "quadric_slam/mapping/tracking_recovery.h"
+
+using quadric_slam::TrackingRecovery;
+
+TEST(TrackingRecovery, MapsUntilALossThenWaitsForConsecutiveAnchoredFrames) {
+  TrackingRecovery::Params params;
+  params.min_landmark_associations = 3;
+  params.confirm_frames = 2;
+  TrackingRecovery recovery(params);
+  EXPECT_FALSE(recovery.recovering());
+  recovery.frameMapped(0);  // mapping as usual: nothing to recover from
+  EXPECT_FALSE(recovery.recovering());
+
+  recovery.trackingLost(10);
+  EXPECT_TRUE(recovery.recovering());
+  EXPECT_EQ(recovery.losses(), 1);
+  recovery.trackingLost(10);  // still the same loss
+  EXPECT_EQ(recovery.losses(), 1);
+  recovery.frameMapped(3);  // one anchored frame ...
+  recovery.frameMapped(2);  // ... then too few associations: the count starts again
+  recovery.frameMapped(4);
+  EXPECT_TRUE(recovery.recovering());
+  recovery.frameMapped(5);  // two in a row
+  EXPECT_FALSE(recovery.recovering());
+  EXPECT_EQ(recovery.recoveries(), 1);
+}
+
+TEST(TrackingRecovery, ALossDuringRecoveryRestartsTheCount) {
+  TrackingRecovery::Params params;
+  params.confirm_frames = 3;
+  TrackingRecovery recovery(params);
+  recovery.trackingLost(10);
+  recovery.frameMapped(5);
+  recovery.frameMapped(5);
+  recovery.trackingLost(10);
+  recovery.frameMapped(5);
+  recovery.frameMapped(5);
+  EXPECT_TRUE(recovery.recovering());
+  recovery.frameMapped(5);
+  EXPECT_FALSE(recovery.recovering());
+}
+
+TEST(TrackingRecovery, AnAlmostEmptyMapHasNothingToWaitFor) {
+  TrackingRecovery::Params params;
+  params.min_map_landmarks = 3;
+  TrackingRecovery recovery(params);
+  recovery.trackingLost(2);
+  EXPECT_FALSE(recovery.recovering());
+  EXPECT_EQ(recovery.losses(), 0);
+}
+
+TEST(TrackingRecovery, GivesUpAfterMaxFramesWhenAsked) {
+  TrackingRecovery::Params params;
+  params.max_frames = 4;
+  TrackingRecovery recovery(params);
+  recovery.trackingLost(10);
+  for (int i = 0; i < 3; ++i)
+    recovery.frameMapped(0);
+  EXPECT_TRUE(recovery.recovering());
+  recovery.frameMapped(0);
+  EXPECT_FALSE(recovery.recovering());
+  EXPECT_EQ(recovery.timeouts(), 1);
+  EXPECT_EQ(recovery.recoveries(), 0);
+  params.max_frames = 0;  // the default waits
+  TrackingRecovery waiting(params);
+  waiting.trackingLost(10);
+  for (int i = 0; i < 1000; ++i)
+    waiting.frameMapped(0);
+  EXPECT_TRUE(waiting.recovering());
+}
+
+TEST(TrackingRecovery, BadParametersAreNamed) {
+  TrackingRecovery::Params params;
+  params.confirm_frames = 0;
+  try {
+    TrackingRecovery recovery(params);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("confirm_frames"), std::string::npos) << e.what();
+  }
+  params = {};
+  params.min_landmark_associations = 0;
+  EXPECT_THROW(TrackingRecovery{params}, std::invalid_argument);
+}
