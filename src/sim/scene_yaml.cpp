@@ -242,10 +242,37 @@ void readHandheld(const YAML::Node& node, HandheldTrajectory::Params* h) {
 void readDepth(const YAML::Node& node, KinectDepthModel::Params* d) {
   const std::string where = "depth_noise: ";
   checkKeys(node,
-            {"min_range", "max_range", "sigma_constant", "sigma_quadratic", "sigma_reference_depth",
-             "focal_px", "baseline", "disparity_resolution", "max_incidence", "edge_dropout_px",
-             "edge_jump_ratio", "dropout_probability"},
+            {"min_range",
+             "max_range",
+             "sigma_constant",
+             "sigma_quadratic",
+             "sigma_reference_depth",
+             "focal_px",
+             "baseline",
+             "disparity_resolution",
+             "max_incidence",
+             "edge_dropout_px",
+             "edge_jump_ratio",
+             "dropout_probability",
+             "model",
+             "sigma_scale",
+             "distortion_r2",
+             "distortion_r4",
+             "pattern_amplitude",
+             "pattern_wavelength_px",
+             "pattern_seed",
+             "correlated_fraction",
+             "correlation_px",
+             "projector_side"},
             where);
+  // The preset first; the keys below override its terms.
+  if (node["model"]) {
+    try {
+      KinectDepthModel::applyModel(node["model"].as<std::string>(), d);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(where + "'model': " + e.what());
+    }
+  }
   optional(node, "min_range", where, &d->min_range);
   optional(node, "max_range", where, &d->max_range);
   optional(node, "sigma_constant", where, &d->sigma_constant);
@@ -263,6 +290,25 @@ void readDepth(const YAML::Node& node, KinectDepthModel::Params* d) {
   }
   optional(node, "edge_jump_ratio", where, &d->edge_jump_ratio);
   optional(node, "dropout_probability", where, &d->dropout_probability);
+  optional(node, "sigma_scale", where, &d->sigma_scale);
+  optional(node, "distortion_r2", where, &d->distortion_r2);
+  optional(node, "distortion_r4", where, &d->distortion_r4);
+  optional(node, "pattern_amplitude", where, &d->pattern_amplitude);
+  optional(node, "pattern_wavelength_px", where, &d->pattern_wavelength_px);
+  if (node["pattern_seed"]) {
+    const double seed = readDouble(node["pattern_seed"], "pattern_seed", where);
+    if (seed != std::floor(seed) || seed < 0 || seed > 2e9)
+      throw std::runtime_error(where + "'pattern_seed' must be a non-negative integer");
+    d->pattern_seed = static_cast<int>(seed);
+  }
+  optional(node, "correlated_fraction", where, &d->correlated_fraction);
+  optional(node, "correlation_px", where, &d->correlation_px);
+  if (node["projector_side"]) {
+    const double side = readDouble(node["projector_side"], "projector_side", where);
+    if (side != -1.0 && side != 0.0 && side != 1.0)
+      throw std::runtime_error(where + "'projector_side' must be -1, 0 or 1");
+    d->projector_side = static_cast<int>(side);
+  }
   try {
     d->validate();
   } catch (const std::invalid_argument& e) {
@@ -392,7 +438,14 @@ std::string sceneYamlString(const Scene& scene) {
       << YAML::Key << "max_incidence" << YAML::Value << d.max_incidence << YAML::Key
       << "edge_dropout_px" << YAML::Value << d.edge_dropout_px << YAML::Key << "edge_jump_ratio"
       << YAML::Value << d.edge_jump_ratio << YAML::Key << "dropout_probability" << YAML::Value
-      << d.dropout_probability;
+      << d.dropout_probability << YAML::Key << "sigma_scale" << YAML::Value << d.sigma_scale
+      << YAML::Key << "distortion_r2" << YAML::Value << d.distortion_r2 << YAML::Key
+      << "distortion_r4" << YAML::Value << d.distortion_r4 << YAML::Key << "pattern_amplitude"
+      << YAML::Value << d.pattern_amplitude << YAML::Key << "pattern_wavelength_px" << YAML::Value
+      << d.pattern_wavelength_px << YAML::Key << "pattern_seed" << YAML::Value << d.pattern_seed
+      << YAML::Key << "correlated_fraction" << YAML::Value << d.correlated_fraction << YAML::Key
+      << "correlation_px" << YAML::Value << d.correlation_px << YAML::Key << "projector_side"
+      << YAML::Value << d.projector_side;
   out << YAML::EndMap;
   out << YAML::Key << "primitives" << YAML::Value << YAML::BeginSeq;
   for (const PrimitiveSpec& p : scene.primitives) {

@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "quadric_slam/io/map_yaml.h"
-#include "quadric_slam/sim/scene_yaml.h"
 #include "quadric_slam/ros/tum_bag_writer.h"
 #include "quadric_slam/sim/renderer.h"
+#include "quadric_slam/sim/scene_yaml.h"
 #include "quadric_slam/sim/sequence_generator.h"
 #include "quadric_slam/sim/surfaces.h"
 #include "quadric_slam/sim/tum_folder_writer.h"
@@ -39,6 +39,8 @@ Renders a synthetic Kinect-like RGB-D sequence in the TUM RGB-D layout.
   --no-folder            do not write rgb/, depth/, rgb.txt, depth.txt
   --no-labels            do not write labels/
   --no-noise             depth without the Kinect model (true depth everywhere)
+  --depth-model M        harsh | nguyen: the depth model's preset, replacing the scene's
+                         depth_noise model terms (default: the scene's, harsh when not given)
   --threads N            worker threads (default: all cores)
   --png-compression N    PNG compression level 0..9 (default 1)
   --bag-compression C    none | lz4 | bz2 (default none)
@@ -49,7 +51,7 @@ DIR/quadrics_gt.yaml (map schema) and DIR/scene.yaml (the effective scene).
 )";
 
 struct Options {
-  std::string out, scene, trajectory = "handheld", name;
+  std::string out, scene, trajectory = "handheld", name, depth_model;
   double seconds = 10.0;
   std::uint64_t seed = 1;
   bool bag = true, folder = true, labels = true, noise = true;
@@ -106,6 +108,9 @@ Options parse(int argc, char** argv) {
       o.folder = false;
     } else if (a == "--no-labels") {
       o.labels = false;
+    } else if (a == "--depth-model") {
+      o.depth_model = value(i);
+      qs::KinectDepthModel::paramsForModel(o.depth_model);  // throws for an unknown name
     } else if (a == "--no-noise") {
       o.noise = false;
     } else if (a == "--threads") {
@@ -159,6 +164,8 @@ int run(int argc, char** argv) {
   const Options o = parse(argc, argv);
   qs::Scene scene = qs::readSceneYaml(o.scene);
   applyCameraOverrides(o, &scene);
+  if (!o.depth_model.empty())
+    qs::KinectDepthModel::applyModel(o.depth_model, &scene.depth);
   const std::string name = o.name.empty() ? scene.name : o.name;
 
   std::vector<qs::StampedPose> poses;

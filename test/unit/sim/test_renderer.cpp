@@ -39,7 +39,9 @@ Renderer makeRenderer(const Scene& scene, bool noise, int threads = 1) {
   Renderer::Params params;
   params.noise = noise;
   params.threads = threads;
-  KinectDepthModel::Params depth;
+  // The independent-noise model: these tests check that the renderer hands the model's noise
+  // through; the harsh model's own statistics are tested in test_kinect_depth_model.cpp.
+  KinectDepthModel::Params depth = KinectDepthModel::nguyenParams();
   depth.dropout_probability = 0.0;
   return Renderer(buildSurfaces(scene), kCamera, depth, params);
 }

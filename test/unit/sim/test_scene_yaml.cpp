@@ -121,6 +121,13 @@ TEST(SceneYaml, RoundTripKeepsEveryField) {
   EXPECT_EQ(b.handheld.start_stamp, a.handheld.start_stamp);
   EXPECT_EQ(b.depth.edge_dropout_px, a.depth.edge_dropout_px);
   EXPECT_EQ(b.depth.sigma_quadratic, a.depth.sigma_quadratic);
+  EXPECT_EQ(b.depth.sigma_scale, a.depth.sigma_scale);
+  EXPECT_EQ(b.depth.distortion_r2, a.depth.distortion_r2);
+  EXPECT_EQ(b.depth.pattern_amplitude, a.depth.pattern_amplitude);
+  EXPECT_EQ(b.depth.pattern_seed, a.depth.pattern_seed);
+  EXPECT_EQ(b.depth.correlated_fraction, a.depth.correlated_fraction);
+  EXPECT_EQ(b.depth.correlation_px, a.depth.correlation_px);
+  EXPECT_EQ(b.depth.projector_side, a.depth.projector_side);
   ASSERT_EQ(b.primitives.size(), a.primitives.size());
   for (std::size_t i = 0; i < a.primitives.size(); ++i) {
     const PrimitiveSpec &p = a.primitives[i], &q = b.primitives[i];
@@ -171,4 +178,32 @@ TEST(SceneYaml, ReadErrorsNameTheFile) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/scene.yaml"), std::string::npos);
   }
+}
+
+TEST(SceneYaml, DepthModelPresetThenOverrides) {
+  const std::string base = kMinimal;
+  // Default: the harsh model.
+  EXPECT_EQ(parseSceneYaml(base).depth.correlated_fraction,
+            KinectDepthModel::harshParams().correlated_fraction);
+  const Scene nguyen = parseSceneYaml(base + "depth_noise:\n  model: nguyen\n");
+  EXPECT_EQ(nguyen.depth.sigma_scale, 1.0);
+  EXPECT_EQ(nguyen.depth.correlated_fraction, 0.0);
+  EXPECT_EQ(nguyen.depth.distortion_r2, 0.0);
+  EXPECT_EQ(nguyen.depth.projector_side, 0);
+  const Scene tuned = parseSceneYaml(
+      base + "depth_noise:\n  model: nguyen\n  sigma_scale: 1.5\n  correlation_px: 2.5\n");
+  EXPECT_EQ(tuned.depth.sigma_scale, 1.5);
+  EXPECT_EQ(tuned.depth.correlation_px, 2.5);
+  EXPECT_EQ(tuned.depth.correlated_fraction, 0.0);
+  expectError(base + "depth_noise:\n  model: gentle\n", "'model'");
+  expectError(base + "depth_noise:\n  correlated_fraction: 2\n", "correlated_fraction");
+  expectError(base + "depth_noise:\n  projector_side: 0.5\n", "projector_side");
+}
+
+TEST(SceneYaml, RoomSceneLoads) {
+  const Scene room =
+      readSceneYaml(std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/room.yaml");
+  EXPECT_EQ(room.name, "room");
+  EXPECT_GE(room.primitives.size(), 10u);
+  EXPECT_EQ(room.depth.sigma_scale, KinectDepthModel::harshParams().sigma_scale);
 }
