@@ -1,6 +1,7 @@
 #include "quadric_slam/frontend/plane_region_grower.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -90,6 +91,34 @@ void PlaneRegionGrower::Params::validate() const {
           "merge_angle must be in [0, pi/2) rad, got " + std::to_string(merge_angle));
   require(seed_stride >= 1 && seed_stride <= 64,
           "seed_stride must be in [1, 64], got " + std::to_string(seed_stride));
+  require(noise_scale > 0, "noise_scale must be > 0, got " + std::to_string(noise_scale));
+  require(
+      quantisation_factor >= 0 && quantisation_factor <= 0.1,
+      "quantisation_factor must be in [0, 0.1] 1/m, got " + std::to_string(quantisation_factor));
+  require(bend_factor >= 0 && bend_factor <= 0.1,
+          "bend_factor must be in [0, 0.1] 1/m, got " + std::to_string(bend_factor));
+  require(noise_sigmas > 0 && noise_sigmas <= 10,
+          "noise_sigmas must be in (0, 10], got " + std::to_string(noise_sigmas));
+  require(min_fragment_points >= 3,
+          "min_fragment_points must be >= 3, got " + std::to_string(min_fragment_points));
+  require(merge_rms_factor >= 1 && merge_rms_factor <= 10,
+          "merge_rms_factor must be in [1, 10], got " + std::to_string(merge_rms_factor));
+  require(fill_max_normal_angle >= 0 && fill_max_normal_angle < M_PI / 2,
+          "fill_max_normal_angle must be in [0, pi/2) rad, got " +
+              std::to_string(fill_max_normal_angle));
+}
+
+double kinectDepthSigma(double z, double noise_scale, double quantisation_factor) {
+  const double axial = noise_scale * (0.0012 + 0.0019 * (z - 0.4) * (z - 0.4));
+  const double step = quantisation_factor * z * z;
+  return std::sqrt(axial * axial + step * step / 12.0);
+}
+
+double PlaneRegionGrower::pointThreshold(double z) const {
+  return std::max(
+      depthThreshold(z, params_.distance_factor, params_.min_distance),
+      params_.noise_sigmas * kinectDepthSigma(z, params_.noise_scale, params_.quantisation_factor) +
+          params_.bend_factor * z * z);
 }
 
 PlaneRegionGrower::PlaneRegionGrower(const Params& params) : params_(params) {
@@ -177,8 +206,7 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::grow(
           const double agreement = n.dot(normal);
           if (std::abs(agreement) < cos_angle)
             continue;
-          if (std::abs(n.dot(p) - d) >
-              depthThreshold(q.z, params_.distance_factor, params_.min_distance))
+          if (std::abs(n.dot(p) - d) > pointThreshold(q.z))
             continue;
           state[j] = 1;
           queue.push_back(j);
@@ -189,7 +217,10 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::grow(
           }
         }
       }
-      bool accepted = static_cast<int>(queue.size()) >= params_.min_points;
+      // Fragments (at least min_fragment_points) are kept for merging; what stays below
+      // min_points after merging is released.
+      bool accepted = static_cast<int>(queue.size()) >=
+                      std::min(params_.min_points, params_.min_fragment_points);
       if (accepted) {
         moments.plane(n, d);
         std::vector<int> indices(queue.begin(), queue.end());
@@ -208,46 +239,190 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::grow(
         state[i] = accepted ? 0 : 2;
     }
   }
-  return mergeCoplanar(cloud, std::move(regions));
+  regions = mergeCoplanar(cloud, std::move(regions));
+  std::vector<Region> planes;
+  for (Region& region : regions) {
+    if (static_cast<int>(region.indices.size()) >= params_.min_points) {
+      planes.push_back(std::move(region));
+    } else {
+      for (int i : region.indices)
+        used[i] = 0;
+    }
+  }
+  fill(cloud, valid, used, planes);
+  return planes;
 }
+
+namespace {
+
+// A region's plane and its noise-derived uncertainty, from its points' moments.
+struct PlaneStats {
+  Moments moments;
+  double sum_variance = 0;  // sum over the points of sigma(z)^2 + bend(z)^2 (m^2)
+  Eigen::Vector3d normal, centroid, axis1, axis2;
+  double rms = 0;                   // RMS distance of the points to the plane (m)
+  double spread1 = 0, spread2 = 0;  // in-plane variances of the points (m^2)
+  double count = 0;
+
+  void update() {
+    count = moments.count;
+    centroid = moments.sum / count + moments.reference;
+    const Eigen::Vector3d mean = moments.sum / count;
+    const Eigen::Matrix3d C = moments.sum_sq / count - mean * mean.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
+    normal = eig.eigenvectors().col(0);
+    if (normal.dot(centroid) > 0)
+      normal = -normal;
+    axis1 = eig.eigenvectors().col(1);
+    axis2 = eig.eigenvectors().col(2);
+    rms = std::sqrt(std::max(0.0, eig.eigenvalues()[0]));
+    spread1 = std::max(1e-8, eig.eigenvalues()[1]);
+    spread2 = std::max(1e-8, eig.eigenvalues()[2]);
+  }
+  // Mean expected variance of a point's distance to the plane (noise and bend, m^2).
+  double noiseVariance() const { return sum_variance / count; }
+  // Independent measurements: neighbouring Kinect depths share the disparity matcher's window,
+  // so a region of N grid points carries about N / kCorrelatedPoints independent ones.
+  static constexpr double kCorrelatedPoints = 16.0;
+  double independent() const { return std::max(1.0, count / kCorrelatedPoints); }
+  // Variance of the plane's offset at x (m^2): the centroid's, and the normal's tilt about it.
+  double offsetVariance(const Eigen::Vector3d& x) const {
+    const double noise = noiseVariance() / independent();
+    const Eigen::Vector3d r = x - centroid;
+    return noise +
+           noise * (std::pow(r.dot(axis1), 2) / spread1 + std::pow(r.dot(axis2), 2) / spread2);
+  }
+  // Variance of the normal's direction (rad^2), its larger in-plane component.
+  double tiltVariance() const { return noiseVariance() / independent() / spread1; }
+};
+
+}  // namespace
 
 std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::mergeCoplanar(
     const pcl::PointCloud<pcl::PointNormal>& cloud, std::vector<Region> regions) const {
-  if (params_.merge_angle <= 0)
+  if (params_.merge_angle <= 0 || regions.size() < 2)
     return regions;
-  const double cos_merge = std::cos(params_.merge_angle);
-  auto close = [&](const Region& a, const Region& b) {
-    const double z = b.plane.point.z();
-    return std::abs(a.plane.distance(b.plane.point)) <
-           depthThreshold(z, params_.distance_factor, params_.min_distance);
+  // Largest first: big regions absorb the fragments.
+  std::stable_sort(regions.begin(), regions.end(), [](const Region& a, const Region& b) {
+    return a.indices.size() > b.indices.size();
+  });
+  const auto variance = [&](double z) {
+    const double s = kinectDepthSigma(z, params_.noise_scale, params_.quantisation_factor);
+    const double bend = params_.bend_factor * z * z;
+    return s * s + bend * bend;
   };
-  bool merged = true;
-  while (merged) {
-    merged = false;
-    for (std::size_t i = 0; i < regions.size() && !merged; ++i) {
-      for (std::size_t j = i + 1; j < regions.size() && !merged; ++j) {
+  std::vector<PlaneStats> stats(regions.size());
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    PlaneStats& st = stats[r];
+    st.moments.reference = regions[r].plane.point;
+    for (int k : regions[r].indices) {
+      const pcl::PointNormal& q = cloud.points[k];
+      st.moments.add(pointOf(q), Eigen::Vector3d::Zero());
+      st.sum_variance += variance(q.z);
+    }
+    st.update();
+  }
+  const double k2 = params_.noise_sigmas * params_.noise_sigmas;
+  const double min_cos = std::cos(params_.merge_angle);
+  // Whether b's plane agrees with a's within their covariance, and the merged fit stays within
+  // the noise.
+  const auto coplanar = [&](const PlaneStats& a, const PlaneStats& b) {
+    const double cos_ab = std::abs(a.normal.dot(b.normal));
+    const double angle = std::acos(std::min(1.0, cos_ab));
+    const double tilt = std::sqrt(k2 * (a.tiltVariance() + b.tiltVariance()));
+    if (cos_ab < min_cos && angle > tilt)
+      return false;
+    for (const auto& [p, q] : {std::make_pair(&a, &b), std::make_pair(&b, &a)}) {
+      const double distance = p->normal.dot(q->centroid - p->centroid);
+      const double z = q->centroid.z();
+      const double bend = params_.bend_factor * z * z;
+      // The sensor's distortion tilts parts of one surface against each other by up to about
+      // merge_angle: the offsets may differ by that slope over half their separation.
+      const Eigen::Vector3d separation = q->centroid - p->centroid;
+      const double in_plane = (separation - p->normal.dot(separation) * p->normal).norm();
+      const double allowed =
+          std::sqrt(k2 * (p->offsetVariance(q->centroid) + q->noiseVariance() / q->independent())) +
+          bend + 0.5 * in_plane * std::sin(params_.merge_angle);
+      if (std::abs(distance) > allowed)
+        return false;
+    }
+    PlaneStats merged = a;
+    Moments& m = merged.moments;
+    const Eigen::Vector3d shift = b.moments.reference - m.reference;
+    m.sum_sq += b.moments.sum_sq + b.moments.sum * shift.transpose() +
+                shift * b.moments.sum.transpose() + b.moments.count * shift * shift.transpose();
+    m.sum += b.moments.sum + b.moments.count * shift;
+    m.count += b.moments.count;
+    merged.sum_variance += b.sum_variance;
+    merged.update();
+    return merged.rms <= params_.merge_rms_factor * std::sqrt(merged.noiseVariance());
+  };
+  bool merged_any = true;
+  while (merged_any) {
+    merged_any = false;
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      for (std::size_t j = i + 1; j < regions.size();) {
+        if (!coplanar(stats[i], stats[j])) {
+          ++j;
+          continue;
+        }
         Region& a = regions[i];
-        const Region& b = regions[j];
-        if (std::abs(a.plane.direction.dot(b.plane.direction)) < cos_merge)
-          continue;
-        if (!close(a, b) || !close(b, a))
-          continue;
-        a.indices.insert(a.indices.end(), b.indices.begin(), b.indices.end());
-        Moments moments;
-        moments.reference = a.plane.point;
-        for (int k : a.indices)
-          moments.add(pointOf(cloud.points[k]), Eigen::Vector3d::Zero());
-        Eigen::Vector3d n;
-        double d;
-        moments.plane(n, d);
-        a.plane = PrimitiveShape::plane(n, d);
-        a.plane.point = moments.sum / moments.count + moments.reference;
+        a.indices.insert(a.indices.end(), regions[j].indices.begin(), regions[j].indices.end());
+        PlaneStats& st = stats[i];
+        const PlaneStats& other = stats[j];
+        const Eigen::Vector3d shift = other.moments.reference - st.moments.reference;
+        st.moments.sum_sq += other.moments.sum_sq + other.moments.sum * shift.transpose() +
+                             shift * other.moments.sum.transpose() +
+                             other.moments.count * shift * shift.transpose();
+        st.moments.sum += other.moments.sum + other.moments.count * shift;
+        st.moments.count += other.moments.count;
+        st.sum_variance += other.sum_variance;
+        st.update();
+        a.plane = PrimitiveShape::plane(st.normal, st.normal.dot(st.centroid));
+        a.plane.point = st.centroid;
         regions.erase(regions.begin() + j);
-        merged = true;
+        stats.erase(stats.begin() + j);
+        merged_any = true;
       }
     }
   }
   return regions;
+}
+
+void PlaneRegionGrower::fill(const pcl::PointCloud<pcl::PointNormal>& cloud,
+                             const std::vector<std::uint8_t>& valid,
+                             std::vector<std::uint8_t>& used, std::vector<Region>& regions) const {
+  if (params_.fill_max_normal_angle <= 0)
+    return;
+  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+  const double cos_angle = std::cos(params_.fill_max_normal_angle);
+  std::vector<int> queue;
+  for (Region& region : regions) {
+    const Eigen::Vector3d n = region.plane.direction;
+    const double d = n.dot(region.plane.point);
+    queue = region.indices;
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const int i = queue[head];
+      const int u = i % width, v = i / width;
+      const float zi = cloud.points[i].z;
+      const int neighbours[4] = {u > 0 ? i - 1 : -1, u + 1 < width ? i + 1 : -1,
+                                 v > 0 ? i - width : -1, v + 1 < height ? i + width : -1};
+      for (int j : neighbours) {
+        if (j < 0 || !valid[j] || used[j])
+          continue;
+        const pcl::PointNormal& q = cloud.points[j];
+        if (std::abs(q.z - zi) > params_.max_depth_jump_factor * zi)
+          continue;
+        if (std::abs(n.dot(normalOf(q))) < cos_angle)
+          continue;
+        if (std::abs(n.dot(pointOf(q)) - d) > pointThreshold(q.z))
+          continue;
+        used[j] = 1;
+        queue.push_back(j);
+        region.indices.push_back(j);
+      }
+    }
+  }
 }
 
 }  // namespace quadric_slam

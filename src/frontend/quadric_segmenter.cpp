@@ -727,6 +727,7 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
 QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) {
   QuadricSegmenter::Params c = p;
   c.planes.min_points = std::max(3, p.planes.min_points / (d * d));
+  c.planes.min_fragment_points = std::max(3, p.planes.min_fragment_points / (d * d));
   c.min_curved_points = std::max(4, p.min_curved_points / (d * d));
   c.planes.seed_stride = std::max(1, p.planes.seed_stride / d);
   c.cgal_stride = std::max(1, (p.cgal_stride + d / 2) / d);

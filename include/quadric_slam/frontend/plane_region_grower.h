@@ -22,6 +22,12 @@ inline double depthThreshold(double z, double factor, double min_distance) {
   return std::max(min_distance, factor * z * z);
 }
 
+// Axial depth noise of a Kinect v1 at depth z (m), one standard deviation (m): the model of
+// Nguyen, Izadi and Lovell (3DIMPVT 2012), 0.0012 + 0.0019 (z - 0.4)^2, times noise_scale (real
+// frames' plane residuals are about 1.4x the model), combined with the depth step of the disparity
+// quantisation (1/8 pixel: a step of quantisation_factor * z^2, uniform, std step / sqrt(12)).
+double kinectDepthSigma(double z, double noise_scale, double quantisation_factor);
+
 class PlaneRegionGrower {
  public:
   struct Params {
@@ -40,11 +46,38 @@ class PlaneRegionGrower {
     // Largest shape-operator eigenvalue of a plane (1/m); a cylinder of radius r has 1/r. >= 0.
     double max_curvature = 1.5;
     // Regions of one plane split in the image (e.g. a floor behind an object) are merged when
-    // their normals differ by less than this (rad) and each centroid lies within the distance
-    // threshold of the other's plane; [0, pi/2), 0 = never merge. Default 0.035 (2 deg).
-    double merge_angle = 0.035;
+    // their normals differ by less than this (rad) or within their noise (noise_sigmas), each
+    // centroid lies within the noise of the other's plane (plus the bend and this angle's slope
+    // over half their separation: real Kinect frames tilt the far part of a floor or wall by 1-4
+    // deg against the near part) and the merged fit's RMS stays within the noise
+    // (merge_rms_factor); [0, pi/2), 0 = never merge. Default 0.07 (4 deg).
+    double merge_angle = 0.07;
     // Seeds are tried every seed_stride pixels in u and v, [1, 64].
     int seed_stride = 4;
+    // Sensor noise (kinectDepthSigma): scale of the Nguyen model, > 0, default 1.4; depth step of
+    // the disparity quantisation per z^2 (1/m), [0, 0.1], default 0.0029 (1/8 px over f b = 580 px
+    // x 7.5 cm).
+    double noise_scale = 1.4;
+    double quantisation_factor = 0.0029;
+    // Low-frequency bend of a flat surface in the depth image (the sensor's systematic distortion,
+    // about 1 cm towards the image corners at 3 m): bend_factor * z^2 (1/m), [0, 0.1]. Tolerated
+    // on top of the noise when growing, merging and filling.
+    double bend_factor = 0.0011;
+    // Growing: a point joins when within max(distance threshold above, noise_sigmas * sigma(z) +
+    // bend(z)) of the region's plane. Merging: plane parameters must agree within noise_sigmas
+    // standard deviations of their noise-derived covariance. (0, 10], default 3.
+    double noise_sigmas = 3.0;
+    // Regions smaller than min_points but of at least min_fragment_points (points of the cloud
+    // grid, >= 3) are kept as fragments: they become planes only by merging with coplanar regions
+    // (a wall split by occluders, holes or noisy normals). Default 100.
+    int min_fragment_points = 100;
+    // Merging: the merged fit's RMS must stay below merge_rms_factor times the noise expected of
+    // its points (RMS of sigma(z) and the bend), [1, 10], default 1.5.
+    double merge_rms_factor = 1.5;
+    // Filling: free points 4-connected to a plane (no depth jump) join it when within the growing
+    // threshold of its final plane and with a normal within fill_max_normal_angle (rad), [0,
+    // pi/2); 0 = no filling. Default 0.45 (far normals are noisy; the distance test decides).
+    double fill_max_normal_angle = 0.45;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -57,7 +90,8 @@ class PlaneRegionGrower {
 
   explicit PlaneRegionGrower(const Params& params);
 
-  // Returned regions are distinct planes (coplanar pieces merged, see merge_angle).
+  // Returned regions are distinct planes (coplanar pieces merged, see merge_angle and the noise
+  // parameters), of at least min_points each.
   // valid[i] says whether point i may be used (finite point and normal, in range); used[i] is set
   // for the points of every returned region (and read: used points are skipped).
   std::vector<Region> grow(const pcl::PointCloud<pcl::PointNormal>& cloud,
@@ -69,6 +103,11 @@ class PlaneRegionGrower {
  private:
   std::vector<Region> mergeCoplanar(const pcl::PointCloud<pcl::PointNormal>& cloud,
                                     std::vector<Region> regions) const;
+  // Adds the free points connected to each region that fit its plane (fill_max_normal_angle).
+  void fill(const pcl::PointCloud<pcl::PointNormal>& cloud, const std::vector<std::uint8_t>& valid,
+            std::vector<std::uint8_t>& used, std::vector<Region>& regions) const;
+  // Distance threshold of a point at depth z to its plane (growing and filling).
+  double pointThreshold(double z) const;
 
   Params params_;
 };
