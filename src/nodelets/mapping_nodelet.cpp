@@ -8,7 +8,7 @@
 //             frame id that differs gets a throttled warning (normal_estimation's ~output_frame
 //             names the clouds' frame, odometry's ~camera_frame the tracked one: set them equal).
 // Publishes   map (quadric_slam/QuadricMap in ~map_frame, latched: on keyframes, after a load or
-//             a reset)
+//             a reset; ids of landmarks merged into others in merged_ids / merged_into)
 //             markers (visualization_msgs/MarkerArray, latched, with the map)
 //             reconstruction (sensor_msgs/PointCloud2 x y z rgb label in ~map_frame, latched: every
 //             ~reconstruction_every_keyframes keyframes, on ~save_map and after ~load_map)
@@ -17,7 +17,8 @@
 //             /diagnostics (landmarks per class, window, solve time, associations, frames
 //             processed and dropped, processing time median / p95 of the latest frames, every
 //             ~diagnostic_period)
-// Services    ~save_map (quadric_slam/SaveMap): map YAML + reconstruction PCD beside it
+// Services    ~save_map (quadric_slam/SaveMap): map YAML + reconstruction PCD beside it (landmarks
+//             that are one surface are merged first)
 //             ~load_map (quadric_slam/LoadMap): start from a saved map, optionally localisation
 //             only
 // All parameters are documented in config/mapping.yaml.
@@ -56,14 +57,14 @@
 #include "quadric_slam/LoadMap.h"
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/SaveMap.h"
+#include "quadric_slam/eval/recent_durations.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
-#include "quadric_slam/eval/recent_durations.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/diagnostics.h"
-#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/drop_reporter.h"
+#include "quadric_slam/ros/frame_ids.h"
 #include "quadric_slam/ros/map_files.h"
 #include "quadric_slam/ros/map_publisher.h"
 #include "quadric_slam/ros/params.h"
@@ -311,8 +312,9 @@ class MappingNodelet : public nodelet::Nodelet {
     if (result.rejected_measurements > 0)
       observation_drops_.report("the mapper refused: " + result.message);
 
-    // 5. The reconstruction grows on keyframes.
+    // 5. The reconstruction grows on keyframes (after the points of merged landmarks moved).
     if (result.keyframe) {
+      applyMergesToReconstruction(result.merges, reconstruction_.get());
       addKeyframeToReconstruction(frame, result, mapper_->map(), reconstruction_.get());
       ++keyframes_;
     }
@@ -345,6 +347,7 @@ class MappingNodelet : public nodelet::Nodelet {
     for (const MeasurementResult& m : result.update.measurements) {
       switch (m.fate) {
         case MeasurementFate::kLandmark:
+        case MeasurementFate::kJoined:
           ++stats_.last.to_landmarks;
           break;
         case MeasurementFate::kCandidate:
@@ -366,7 +369,8 @@ class MappingNodelet : public nodelet::Nodelet {
       stats_.solve_ms = 1e3 * result.optimisation_seconds;
     }
     stats_.processing_times.add(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+            .count());
   }
 
   // The observations are used in the frame whose pose odom gives (its child frame). Another frame
@@ -475,6 +479,8 @@ class MappingNodelet : public nodelet::Nodelet {
       const std::string path = mapPathFor(request.path, response);
       if (path.empty())
         return true;
+      // Each surface once in the saved map (QuadricMapper::mergeDuplicates).
+      applyMergesToReconstruction(mapper_->mergeDuplicates(), reconstruction_.get());
       const std::vector<QuadricLandmark> landmarks = mapper_->landmarks();
       const sensor_msgs::PointCloud2Ptr cloud = reconstructionCloud(ros::Time::now());
       saveMapFiles(path, landmarks, map_frame_, *cloud);
@@ -526,7 +532,7 @@ class MappingNodelet : public nodelet::Nodelet {
     std_msgs::Header header;
     header.stamp = stamp;
     header.frame_id = map_frame_;
-    map_publisher_.publish(mapper_->landmarks(), header);
+    map_publisher_.publish(mapper_->landmarks(), header, mapper_->map().mergedInto());
   }
 
   sensor_msgs::PointCloud2Ptr reconstructionCloud(const ros::Time& stamp) const {
@@ -579,8 +585,8 @@ class MappingNodelet : public nodelet::Nodelet {
     std::map<std::string, int> landmarks_per_class;
     int landmarks = 0, candidates = 0;
     std::string observation_frame, camera_frame;  // of the latest frame (observations, odom child)
-    std::string mode = "mapping";  // or "localisation only"
-    std::string loaded_from;       // the loaded map file, if any
+    std::string mode = "mapping";                 // or "localisation only"
+    std::string loaded_from;                      // the loaded map file, if any
     // At the previous report.
     long reported_processed = 0, reported_dropped = 0, reported_observations_dropped = 0;
   };

@@ -11,7 +11,8 @@
 //   4. quadric segmentation (frontend/quadric_segmenter.h), unless odometry only;
 //   5. odometry (odometry/odometry_tracker.h);
 //   6. mapping (mapping/quadric_mapper.h) once odometry is initialised, and on keyframes the
-//      supporting points of the landmark observations into the reconstruction.
+//      supporting points of the landmark observations into the reconstruction (after moving the
+//      points of landmarks the mapper merged).
 // Every stage is timed under its name (timer()): normals, segmentation, odometry, mapping,
 // reconstruction.
 #pragma once
@@ -21,6 +22,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "quadric_slam/eval/stage_timing.h"
 #include "quadric_slam/frontend/frame.h"
@@ -64,7 +66,7 @@ struct SlamFrameResult {
   bool processed = false;  // false: skipped (message says why), nothing changed
   std::string message;     // why the frame was skipped, or what a stage refused
   OdometryTracker::Result odometry;
-  bool tracking = false;  // odometry is initialised (odometry.T_odom_camera is meaningful)
+  bool tracking = false;           // odometry is initialised (odometry.T_odom_camera is meaningful)
   FrameMeasurements measurements;  // the segmentation's observations (camera frame)
   bool mapped = false;             // the mapper accepted the frame (mapping is meaningful)
   MapperFrameResult mapping;
@@ -78,6 +80,9 @@ class QuadricSlam {
 
   // Forgets odometry, map and reconstruction (landmark ids keep counting).
   void reset();
+  // Merges every pair of landmarks that are the same surface (QuadricMapper::mergeDuplicates) and
+  // moves their reconstruction points to the survivors; call it before saving the map.
+  std::vector<LandmarkMerge> mergeDuplicateLandmarks();
 
   const SlamParams& params() const { return params_; }
   const QuadricMapper& mapper() const { return mapper_; }
