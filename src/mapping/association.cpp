@@ -8,6 +8,7 @@
 
 #include "quadric_slam/geometry/quadric_classes.h"
 #include "quadric_slam/mapping/observation_linearization.h"
+#include "quadric_slam/mapping/surface_fusion.h"
 
 namespace quadric_slam {
 
@@ -19,28 +20,11 @@ void requireRange(bool ok, const char* field, const char* range) {
                                 " must be in " + range);
 }
 
-// Diagonal model-error floor in the class's minimal space: each minimal column of B (Table II) is
-// a translation, rotation or scale direction.
+// Diagonal model-error floor in the class's minimal space (translation, rotation and scale
+// entries of Table II's minimal vector).
 Eigen::MatrixXd floorCovariance(const QuadricAssociator::Params& p, const QuadricModel& target) {
-  const QuadricClassDefinition& def = classDefinition(target.quadricClass());
-  const int k = def.minimal_dimension;
-  Eigen::MatrixXd floor = Eigen::MatrixXd::Zero(k, k);
-  for (int j = 0; j < k; ++j) {
-    int row = 0;
-    def.basis.col(j).cwiseAbs().maxCoeff(&row);
-    double sigma = 0.0;
-    if (row < 3) {
-      sigma = p.floor_translation_sigma;
-    } else if (row < 6) {
-      sigma = p.floor_rotation_sigma;
-    } else {
-      const Eigen::Vector3d column = def.basis.col(j).tail<3>();
-      sigma = p.floor_scale_fraction * column.cwiseProduct(target.scale()).cwiseAbs().sum() /
-              column.cwiseAbs().sum();
-    }
-    floor(j, j) = sigma * sigma;
-  }
-  return floor;
+  return diagonalMinimalCovariance(target, p.floor_translation_sigma, p.floor_rotation_sigma,
+                                   p.floor_scale_fraction);
 }
 
 // Regularised lower incomplete gamma P(a, x) by its power series (converges for every x > 0; the

@@ -1,6 +1,7 @@
 #include "quadric_slam/mapping/landmark_registry.h"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -40,10 +41,11 @@ void LandmarkRegistry::Params::validate() const {
   requireRange(candidate_timeout_frames >= 1 && candidate_timeout_frames <= 100000,
                "candidate_timeout_frames", "[1, 100000]");
   association.validate();
+  merging.validate();
 }
 
 LandmarkRegistry::LandmarkRegistry(const Params& params)
-    : params_(params), associator_(params.association) {
+    : params_(params), associator_(params.association), merger_(params.merging) {
   params_.validate();
 }
 
@@ -140,25 +142,42 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
     }
   }
 
-  // 4. Promotion of candidates seen often enough (this frame's only: others were checked before).
+  // This frame's measurements of candidate `candidate_id` now belong to landmark `landmark_id`.
+  auto relabel = [&update](int candidate_id, MeasurementFate fate, int landmark_id) {
+    for (MeasurementResult& result : update.measurements) {
+      if ((result.fate == MeasurementFate::kCandidate ||
+           result.fate == MeasurementFate::kNewCandidate) &&
+          result.id == candidate_id) {
+        result.fate = fate;
+        result.id = landmark_id;
+      }
+    }
+  };
+  // 4. Promotion of candidates seen often enough (this frame's only: others were checked before),
+  // or joining the landmark of their surface.
   std::vector<QuadricCandidate> kept;
   for (QuadricCandidate& candidate : candidates_) {
     if (promotion_ && candidate.last_frame == frame_index &&
         candidate.observations >= params_.min_observations) {
+      const int joined = sameSurfaceLandmark(candidate, T_map_camera);
+      if (joined != 0) {
+        QuadricLandmark& landmark = landmarks_.at(joined);
+        landmark.observations += candidate.observations;
+        landmark.last_observed = std::max(landmark.last_observed, candidate.last_observed);
+        setLandmarkExtent(
+            &landmark, landmarkExtent(landmark).merged(candidate.extent.transformed(
+                           landmark.quadric_map.pose().inverse() * candidate.quadric_map.pose())));
+        relabel(candidate.id, MeasurementFate::kJoined, joined);
+        update.joined.push_back({joined, candidate.history});
+        continue;
+      }
       QuadricLandmark landmark;
       landmark.id = next_landmark_id_++;
       landmark.quadric_map = candidate.quadric_map;
       landmark.observations = candidate.observations;
       landmark.last_observed = candidate.last_observed;
       setLandmarkExtent(&landmark, candidate.extent);
-      for (MeasurementResult& result : update.measurements) {
-        if ((result.fate == MeasurementFate::kCandidate ||
-             result.fate == MeasurementFate::kNewCandidate) &&
-            result.id == candidate.id) {
-          result.fate = MeasurementFate::kPromoted;
-          result.id = landmark.id;
-        }
-      }
+      relabel(candidate.id, MeasurementFate::kPromoted, landmark.id);
       update.promoted.push_back(landmark.id);
       update.promoted_history.push_back(candidate.history);
       landmarks_.emplace(landmark.id, landmark);
@@ -184,6 +203,42 @@ void LandmarkRegistry::setEstimate(int id, const QuadricModel& quadric_map,
   landmark.covariance = covariance;
 }
 
+int LandmarkRegistry::sameSurfaceLandmark(const QuadricCandidate& candidate,
+                                          const Eigen::Isometry3d& T_map_camera) const {
+  if (!merger_.params().enabled)
+    return 0;
+  QuadricLandmark as_landmark;  // no covariance: the merger's missing one stands for it
+  as_landmark.quadric_map = candidate.quadric_map;
+  as_landmark.extent_min = candidate.extent.min;
+  as_landmark.extent_max = candidate.extent.max;
+  int best = 0;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  for (const auto& [id, landmark] : landmarks_) {
+    if (!sameKind(landmark.quadric_map, candidate.quadric_map) ||
+        !associator_.inRange(landmark.quadric_map, landmarkExtent(landmark), T_map_camera))
+      continue;
+    const LandmarkMerger::Comparison c = merger_.compare(landmark, as_landmark);
+    if (c.sameSurface() && c.squared_distance < best_d2) {
+      best = id;
+      best_d2 = c.squared_distance;
+    }
+  }
+  return best;
+}
+
+void LandmarkRegistry::absorbLandmark(int merged_id, const QuadricLandmark& survivor) {
+  if (merged_id == survivor.id)
+    throw std::invalid_argument("LandmarkRegistry::absorbLandmark: landmark " +
+                                std::to_string(merged_id) + " cannot absorb itself");
+  landmarks_.at(merged_id);  // both must exist (std::out_of_range) before anything changes
+  landmarks_.at(survivor.id) = survivor;
+  landmarks_.erase(merged_id);
+  for (auto& [id, into] : merged_into_)
+    if (into == merged_id)
+      into = survivor.id;
+  merged_into_[merged_id] = survivor.id;
+}
+
 void LandmarkRegistry::insertLandmark(const QuadricLandmark& landmark) {
   if (landmark.id < 1)
     throw std::invalid_argument("LandmarkRegistry::insertLandmark: id " +
@@ -205,6 +260,7 @@ void LandmarkRegistry::insertLandmark(const QuadricLandmark& landmark) {
 void LandmarkRegistry::clear() {
   landmarks_.clear();
   candidates_.clear();
+  merged_into_.clear();
 }
 
 }  // namespace quadric_slam

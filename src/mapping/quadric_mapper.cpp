@@ -177,7 +177,8 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
   Keyframe kf;
   for (size_t m = 0; m < valid.size(); ++m) {
     const MeasurementResult& r = result.update.measurements[m];
-    if (r.fate != MeasurementFate::kLandmark && r.fate != MeasurementFate::kPromoted)
+    if (r.fate != MeasurementFate::kLandmark && r.fate != MeasurementFate::kPromoted &&
+        r.fate != MeasurementFate::kJoined)
       continue;
     kf.observations.push_back({r.id, valid[m]});
     if (!window_.containsLandmark(r.id))
@@ -187,7 +188,6 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
 
   // 4. Window optimisation on keyframes.
   if (keyframe) {
-    const auto optimisation_start = std::chrono::steady_clock::now();
     kf.frame_index = frame_index_;
     kf.stamp = frame.stamp;
     kf.T_map_camera = T_map_predicted;
@@ -201,16 +201,71 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
           window_.addObservation(o.frame_index, {result.update.promoted[p], o.measurement});
       }
     }
+  }
+  // The earlier observations of candidates that joined a landmark become its factors in the window
+  // keyframes that made them (this frame's is in kf when it is a keyframe).
+  for (const MapUpdate::Joined& joined : result.update.joined) {
+    for (const CandidateObservation& o : joined.history) {
+      if (o.frame_index != frame_index_)
+        window_.addObservation(o.frame_index, {joined.landmark_id, o.measurement});
+    }
+  }
+  if (keyframe) {
+    const auto optimisation_start = std::chrono::steady_clock::now();
     result.window = window_.optimize(&map_);
     result.T_map_camera = window_.keyframes().back().T_map_camera;
     covariance_since_keyframe_.setZero();
     result.keyframe = true;
     result.optimisation_seconds = secondsSince(optimisation_start);
+    // 5. The window's landmarks against the map: each surface once.
+    const auto merge_start = std::chrono::steady_clock::now();
+    const std::set<int> in_window = window_.landmarkIds();
+    result.merges = mergeLandmarks(&in_window);
+    result.merge_seconds = secondsSince(merge_start);
   } else {
     result.T_map_camera = T_map_predicted;
   }
   result.T_map_odom = result.T_map_camera * T_odom_camera.inverse();
   return result;
+}
+
+std::vector<LandmarkMerge> QuadricMapper::mergeLandmarks(const std::set<int>* subset) {
+  std::vector<LandmarkMerge> merges;
+  const LandmarkMerger& merger = map_.merger();
+  if (localization_only_ || !merger.params().enabled)
+    return merges;
+  for (const DuplicatePair& pair : merger.findDuplicates(map_.landmarks(), subset)) {
+    const auto a = map_.landmarks().find(pair.id_a), b = map_.landmarks().find(pair.id_b);
+    if (a == map_.landmarks().end() || b == map_.landmarks().end())
+      continue;  // one of them was merged earlier in this pass
+    // An earlier merge of this pass may have changed one of them: test again.
+    if (!merger.compare(a->second, b->second).sameSurface())
+      continue;
+    const bool a_fixed = window_.landmarkFixed(pair.id_a),
+               b_fixed = window_.landmarkFixed(pair.id_b);
+    if (a_fixed && b_fixed)
+      continue;  // a loaded, trusted map is not rewritten
+    const bool a_survives = a_fixed || (!b_fixed && LandmarkMerger::survives(a->second, b->second));
+    const QuadricLandmark survivor = a_survives ? a->second : b->second;
+    const QuadricLandmark merged = a_survives ? b->second : a->second;
+    const QuadricLandmark fused = merger.fused(survivor, merged, a_fixed || b_fixed);
+    merges.push_back(
+        {merged.id, survivor.id,
+         Eigen::Isometry3d(fused.quadric_map.pose().inverse() * merged.quadric_map.pose())});
+    window_.mergeLandmark(merged.id, survivor.id, fused.quadric_map);
+    map_.absorbLandmark(merged.id, fused);
+  }
+  return merges;
+}
+
+std::vector<LandmarkMerge> QuadricMapper::mergeDuplicates() {
+  std::vector<LandmarkMerge> all;
+  for (;;) {
+    const std::vector<LandmarkMerge> pass = mergeLandmarks(nullptr);
+    if (pass.empty())
+      return all;
+    all.insert(all.end(), pass.begin(), pass.end());
+  }
 }
 
 void QuadricMapper::reset() {
@@ -260,12 +315,15 @@ int addKeyframeToReconstruction(const FrameMeasurements& frame, const MapperFram
     if (input >= frame.observations.size())
       break;
     const QuadricMeasurement& measurement = frame.observations[input++];
-    if (fate.fate != MeasurementFate::kLandmark && fate.fate != MeasurementFate::kPromoted)
+    if (fate.fate != MeasurementFate::kLandmark && fate.fate != MeasurementFate::kPromoted &&
+        fate.fate != MeasurementFate::kJoined)
       continue;
-    const auto landmark = map.landmarks().find(fate.id);
+    const auto merged = map.mergedInto().find(fate.id);
+    const int id = merged == map.mergedInto().end() ? fate.id : merged->second;
+    const auto landmark = map.landmarks().find(id);
     if (landmark != map.landmarks().end())
-      stored += reconstruction->addPoints(fate.id, landmark->second.quadric_map,
-                                          result.T_map_camera, measurement.support_points);
+      stored += reconstruction->addPoints(id, landmark->second.quadric_map, result.T_map_camera,
+                                          measurement.support_points);
   }
   return stored;
 }
@@ -275,6 +333,12 @@ std::vector<QuadricLandmark> QuadricMapper::landmarks() const {
   for (const auto& [id, landmark] : map_.landmarks())
     out.push_back(landmark);
   return out;
+}
+
+void applyMergesToReconstruction(const std::vector<LandmarkMerge>& merges,
+                                 QuadricReconstruction* reconstruction) {
+  for (const LandmarkMerge& merge : merges)
+    reconstruction->moveLandmark(merge.merged_id, merge.survivor_id, merge.T_survivor_merged);
 }
 
 }  // namespace quadric_slam

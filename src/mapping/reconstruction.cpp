@@ -64,6 +64,23 @@ int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
   return added;
 }
 
+void QuadricReconstruction::moveLandmark(int from, int to, const Eigen::Isometry3d& T_to_from) {
+  const auto source = landmarks_.find(from);
+  if (from == to || source == landmarks_.end())
+    return;
+  LandmarkPoints& target = landmarks_[to];
+  for (const Eigen::Vector3f& p_from : source->second.points_quadric) {
+    if (static_cast<int>(target.points_quadric.size()) >= params_.max_points_per_landmark)
+      break;
+    const Eigen::Vector3d p_to = T_to_from * p_from.cast<double>();
+    if (target.voxels.insert(voxelKey(p_to)).second)
+      target.points_quadric.push_back(p_to.cast<float>());
+  }
+  landmarks_.erase(from);
+  if (landmarks_[to].points_quadric.empty())
+    landmarks_.erase(to);
+}
+
 void QuadricReconstruction::removeLandmark(int id) {
   landmarks_.erase(id);
 }

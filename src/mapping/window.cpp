@@ -11,6 +11,7 @@
 #include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/mapping/factors.h"
 #include "quadric_slam/mapping/observation_linearization.h"
+#include "quadric_slam/mapping/surface_fusion.h"
 
 namespace quadric_slam {
 
@@ -266,6 +267,47 @@ WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
     }
   }
   return last_;
+}
+
+void SlidingWindow::mergeLandmark(int merged_id, int survivor_id,
+                                  const QuadricModel& survivor_estimate) {
+  if (merged_id == survivor_id)
+    return;
+  for (Keyframe& keyframe : keyframes_)
+    for (WindowObservation& observation : keyframe.observations)
+      if (observation.landmark_id == merged_id)
+        observation.landmark_id = survivor_id;
+  auto count = observation_counts_.find(merged_id);
+  if (count != observation_counts_.end()) {
+    observation_counts_[survivor_id] += count->second;
+    observation_counts_.erase(count);
+  }
+  if (fixed_landmarks_.erase(merged_id) > 0)
+    fixed_landmarks_.insert(survivor_id);
+  auto merged_prior = priors_.find(merged_id);
+  if (merged_prior == priors_.end())
+    return;
+  auto survivor_prior = priors_.find(survivor_id);
+  if (survivor_prior == priors_.end()) {
+    // Only the merged landmark had folded observations: they are a prior on the survivor now,
+    // expressed near the survivor's frame (later folds add information in that frame).
+    const AlignedSurface aligned = alignInformation(
+        merged_prior->second.quadric_map, merged_prior->second.information, survivor_estimate);
+    priors_[survivor_id] = {aligned.quadric, aligned.matrix};
+  } else {
+    const SurfaceInformation fused =
+        fuseSurfaces({survivor_prior->second.quadric_map, survivor_prior->second.information},
+                     {merged_prior->second.quadric_map, merged_prior->second.information});
+    survivor_prior->second = {fused.mean, fused.information};
+  }
+  priors_.erase(merged_id);
+}
+
+std::set<int> SlidingWindow::landmarkIds() const {
+  std::set<int> ids;
+  for (const auto& [id, count] : observation_counts_)
+    ids.insert(id);
+  return ids;
 }
 
 void SlidingWindow::clear() {

@@ -8,7 +8,7 @@
 //             frame id that differs gets a throttled warning (normal_estimation's ~output_frame
 //             names the clouds' frame, odometry's ~camera_frame the tracked one: set them equal).
 // Publishes   map (quadric_slam/QuadricMap in ~map_frame, latched: on keyframes, after a load or
-//             a reset)
+//             a reset; ids of landmarks merged into others in merged_ids / merged_into)
 //             markers (visualization_msgs/MarkerArray, latched, with the map)
 //             reconstruction (sensor_msgs/PointCloud2 x y z rgb label in ~map_frame, latched: every
 //             ~reconstruction_every_keyframes keyframes, on ~save_map and after ~load_map)
@@ -17,7 +17,8 @@
 //             /diagnostics (landmarks per class, window, solve time, associations, frames
 //             processed and dropped, processing time median / p95 of the latest frames, every
 //             ~diagnostic_period)
-// Services    ~save_map (quadric_slam/SaveMap): map YAML + reconstruction PCD beside it
+// Services    ~save_map (quadric_slam/SaveMap): map YAML + reconstruction PCD beside it (landmarks
+//             that are one surface are merged first)
 //             ~load_map (quadric_slam/LoadMap): start from a saved map, optionally localisation
 //             only
 // All parameters are documented in config/mapping.yaml.
@@ -332,8 +333,9 @@ class MappingNodelet : public nodelet::Nodelet {
     if (result.rejected_measurements > 0)
       observation_drops_.report("the mapper refused: " + result.message);
 
-    // 5. The reconstruction grows on keyframes.
+    // 5. The reconstruction grows on keyframes (after the points of merged landmarks moved).
     if (result.keyframe) {
+      applyMergesToReconstruction(result.merges, reconstruction_.get());
       addKeyframeToReconstruction(frame, result, mapper_->map(), reconstruction_.get());
       ++keyframes_;
     }
@@ -366,6 +368,7 @@ class MappingNodelet : public nodelet::Nodelet {
     for (const MeasurementResult& m : result.update.measurements) {
       switch (m.fate) {
         case MeasurementFate::kLandmark:
+        case MeasurementFate::kJoined:
           ++stats_.last.to_landmarks;
           break;
         case MeasurementFate::kCandidate:
@@ -501,6 +504,8 @@ class MappingNodelet : public nodelet::Nodelet {
       const std::string path = mapPathFor(request.path, response);
       if (path.empty())
         return true;
+      // Each surface once in the saved map (QuadricMapper::mergeDuplicates).
+      applyMergesToReconstruction(mapper_->mergeDuplicates(), reconstruction_.get());
       const std::vector<QuadricLandmark> landmarks = mapper_->landmarks();
       const sensor_msgs::PointCloud2Ptr cloud = reconstructionCloud(ros::Time::now());
       saveMapFiles(path, landmarks, map_frame_, *cloud);
@@ -552,7 +557,7 @@ class MappingNodelet : public nodelet::Nodelet {
     std_msgs::Header header;
     header.stamp = stamp;
     header.frame_id = map_frame_;
-    map_publisher_.publish(mapper_->landmarks(), header);
+    map_publisher_.publish(mapper_->landmarks(), header, mapper_->map().mergedInto());
   }
 
   sensor_msgs::PointCloud2Ptr reconstructionCloud(const ros::Time& stamp) const {

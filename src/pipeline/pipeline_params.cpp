@@ -71,6 +71,16 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
   readParam(reader, "check_extent", association.check_extent, log);
   readParam(reader, "extent_margin", association.extent_margin, log);
   readParam(reader, "association_max_range", association.max_range, log);
+  LandmarkMerger::Params& merging = map.merging;
+  readParam(reader, "merge_landmarks", merging.enabled, log);
+  readParam(reader, "merge_gate_probability", merging.gate_probability, log);
+  readParam(reader, "merge_floor_translation_sigma", merging.floor_translation_sigma, log);
+  readParam(reader, "merge_floor_rotation_sigma", merging.floor_rotation_sigma, log);
+  readParam(reader, "merge_floor_scale_fraction", merging.floor_scale_fraction, log);
+  readParam(reader, "merge_missing_translation_sigma", merging.missing_translation_sigma, log);
+  readParam(reader, "merge_missing_rotation_sigma", merging.missing_rotation_sigma, log);
+  readParam(reader, "merge_missing_scale_fraction", merging.missing_scale_fraction, log);
+  readParam(reader, "merge_extent_margin", merging.extent_margin, log);
   SlidingWindow::Params& window = mapper.window;
   readParam(reader, "window_size", window.size, log);
   readParam(reader, "max_iterations", window.max_iterations, log);

@@ -133,10 +133,18 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
   return out;
 }
 
-// The supporting points of the keyframe's landmark observations, on their landmarks' surfaces.
+// The points of landmarks merged after the keyframe's solve go to their survivors; then the
+// supporting points of the keyframe's landmark observations, on their landmarks' surfaces.
 void QuadricSlam::addToReconstruction(const FrameMeasurements& measurements,
                                       const MapperFrameResult& mapped) {
+  applyMergesToReconstruction(mapped.merges, &reconstruction_);
   addKeyframeToReconstruction(measurements, mapped, mapper_.map(), &reconstruction_);
+}
+
+std::vector<LandmarkMerge> QuadricSlam::mergeDuplicateLandmarks() {
+  const std::vector<LandmarkMerge> merges = mapper_.mergeDuplicates();
+  applyMergesToReconstruction(merges, &reconstruction_);
+  return merges;
 }
 
 pcl::PointCloud<pcl::PointXYZL> QuadricSlam::reconstructionCloud() const {

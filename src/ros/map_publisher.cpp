@@ -16,12 +16,17 @@ QuadricMapPublisher::QuadricMapPublisher(ros::NodeHandle& nh, const std::string&
 }
 
 void QuadricMapPublisher::publish(const std::vector<QuadricLandmark>& landmarks,
-                                  const std_msgs::Header& header) {
+                                  const std_msgs::Header& header,
+                                  const std::map<int, int>& merged_into) {
   auto map = boost::make_shared<QuadricMap>();
   map->header = header;
   map->quadrics.reserve(landmarks.size());
   for (const QuadricLandmark& landmark : landmarks)
     map->quadrics.push_back(toLandmarkMsg(landmark));
+  for (const auto& [merged, survivor] : merged_into) {
+    map->merged_ids.push_back(static_cast<std::uint32_t>(merged));
+    map->merged_into.push_back(static_cast<std::uint32_t>(survivor));
+  }
   map_pub_.publish(map);
   markers_pub_.publish(boost::make_shared<visualization_msgs::MarkerArray>(
       quadricMarkers(landmarks, header, style_)));

@@ -209,7 +209,9 @@ int main(int argc, char** argv) {
     int status_counts[3] = {0, 0, 0};
     std::size_t frames_recovering = 0;  // the mapper localised only (after a loss of tracking)
     std::map<std::string, std::size_t> observations_per_class;
-    std::size_t frames = 0, skipped = 0;
+    std::size_t frames = 0, skipped = 0, keyframes = 0, joined = 0, merged_online = 0;
+    // How each measurement fared against the landmarks (AssociationOutcome, mapping/association.h).
+    std::map<qs::AssociationOutcome, std::size_t> outcomes;
     const auto start = std::chrono::steady_clock::now();
     qs::RgbdFrame frame;
     while (frames < total && read_timer.time("read", [&] { return source->next(frame); })) {
@@ -228,9 +230,14 @@ int main(int argc, char** argv) {
       frames_recovering += result.recovering ? 1 : 0;
       if (result.tracking)
         odom_trajectory.push_back({frame.stamp, result.odometry.T_odom_camera});
-      if (result.mapped)
+      if (result.mapped) {
         map_trajectory.push_back({frame.stamp, result.mapping.T_map_camera});
-      else if (!o.odometry_only && result.tracking)
+        keyframes += result.mapping.keyframe;
+        joined += result.mapping.update.joined.size();
+        merged_online += result.mapping.merges.size();
+        for (const qs::MeasurementResult& m : result.mapping.update.measurements)
+          ++outcomes[m.landmark_association.outcome];
+      } else if (!o.odometry_only && result.tracking)
         std::cerr << "\nrun_bag: frame " << frame.stamp << ": " << result.message << "\n";
       if (frames % o.sample_every == 0 || frames == total) {
         const auto now = std::chrono::steady_clock::now();
@@ -290,6 +297,28 @@ int main(int argc, char** argv) {
         "timing %s/timing.json\nresources %s/resources.csv\n",
         o.out_dir.c_str(), o.out_dir.c_str(), o.out_dir.c_str(), o.out_dir.c_str());
     if (!o.odometry_only) {
+      // Each surface once (mapping/landmark_merger.h): duplicates left by the online merging, the
+      // merge before saving, and none left after it.
+      const qs::LandmarkMerger& merger = slam.mapper().map().merger();
+      const std::size_t duplicates_online =
+          merger.findDuplicates(slam.mapper().map().landmarks()).size();
+      const std::size_t merged_at_save = slam.mergeDuplicateLandmarks().size();
+      const std::size_t duplicates_saved =
+          merger.findDuplicates(slam.mapper().map().landmarks()).size();
+      std::printf("keyframes %zu (%.1f%% of frames)\n", keyframes,
+                  100.0 * keyframes / std::max<std::size_t>(frames, 1));
+      std::printf(
+          "landmark association: matched %zu taken_by_better %zu no_overlap %zu "
+          "outside_gate %zu no_target %zu\n",
+          outcomes[qs::AssociationOutcome::kMatched],
+          outcomes[qs::AssociationOutcome::kTakenByBetter],
+          outcomes[qs::AssociationOutcome::kNoOverlap],
+          outcomes[qs::AssociationOutcome::kOutsideGate],
+          outcomes[qs::AssociationOutcome::kNoTargetOfClass]);
+      std::printf(
+          "candidates joined at promotion %zu, landmarks merged online %zu, duplicate pairs "
+          "left %zu, merged at save %zu, duplicate pairs saved %zu\n",
+          joined, merged_online, duplicates_online, merged_at_save, duplicates_saved);
       const std::vector<qs::QuadricLandmark> landmarks = slam.mapper().landmarks();
       qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"), o.out_dir + "/map.yaml");
       std::map<std::string, int> per_class;

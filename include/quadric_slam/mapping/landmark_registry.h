@@ -2,8 +2,12 @@
 // quadric to have been observed in 5 frames before it is added"). Each frame's measurements are
 // associated (mapping/association.h) first against the landmarks, the rest against the candidates;
 // a measurement matching neither starts a new candidate. A candidate seen in min_observations
-// frames becomes a landmark with a fresh id (landmark ids are never reused); a candidate not seen
-// for candidate_timeout_frames frames expires, so spurious one-off detections never reach the map.
+// frames becomes a landmark with a fresh id (landmark ids are never reused), unless it is the same
+// surface as a landmark (mapping/landmark_merger.h; the candidate's estimate has no marginal, so
+// the merger's missing covariance stands for it): then it joins that landmark instead. A candidate
+// not seen for candidate_timeout_frames frames expires, so spurious one-off detections never reach
+// the map. Landmarks found to be one surface later are merged through absorbLandmark(), which
+// keeps a record of the merged ids for subscribers (mergedInto()).
 // Landmark estimates are refined elsewhere (mapping/window.h); here they are created and counted.
 // (The map as published is the message quadric_slam/QuadricMap, ros/map_publisher.h.)
 #pragma once
@@ -15,6 +19,7 @@
 
 #include "quadric_slam/mapping/association.h"
 #include "quadric_slam/mapping/landmark.h"
+#include "quadric_slam/mapping/landmark_merger.h"
 #include "quadric_slam/types/observation.h"
 
 namespace quadric_slam {
@@ -43,6 +48,8 @@ enum class MeasurementFate {
   kCandidate,     // associated with candidate `id`
   kNewCandidate,  // started candidate `id`
   kPromoted,      // its candidate reached min_observations: now landmark `id`
+  kJoined,        // its candidate reached min_observations and was the same surface as landmark
+                  // `id` (landmark_merger.h): it joined it
 };
 
 struct MeasurementResult {
@@ -57,6 +64,13 @@ struct MapUpdate {
   // frame's included).
   std::vector<int> promoted;
   std::vector<std::vector<CandidateObservation>> promoted_history;
+  // Candidates that joined an existing landmark at promotion, with their observations (this
+  // frame's included), to become that landmark's factors.
+  struct Joined {
+    int landmark_id = 0;
+    std::vector<CandidateObservation> history;
+  };
+  std::vector<Joined> joined;
   int expired_candidates = 0;
 };
 
@@ -68,6 +82,7 @@ class LandmarkRegistry {
     // A candidate not seen for more than this many frames is dropped, [1, 100000].
     int candidate_timeout_frames = 15;
     QuadricAssociator::Params association;
+    LandmarkMerger::Params merging;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -100,16 +115,32 @@ class LandmarkRegistry {
   void setPromotion(bool enabled) { promotion_ = enabled; }
   bool promotion() const { return promotion_; }
 
-  // Forgets landmarks and candidates; ids keep counting (never reused).
+  // Replaces landmark survivor.id by `survivor` (LandmarkMerger::fused) and removes landmark
+  // merged_id, recording merged_id -> survivor.id (and re-pointing earlier records that named
+  // merged_id). Throws std::out_of_range for unknown ids, std::invalid_argument when they are
+  // equal.
+  void absorbLandmark(int merged_id, const QuadricLandmark& survivor);
+  // Every landmark merged away since the last clear(), with the landmark that holds its surface
+  // now (chains resolved: always a landmark of the map).
+  const std::map<int, int>& mergedInto() const { return merged_into_; }
+
+  // Forgets landmarks, candidates and the merge record; ids keep counting (never reused).
   void clear();
 
   const Params& params() const { return params_; }
   const QuadricAssociator& associator() const { return associator_; }
+  const LandmarkMerger& merger() const { return merger_; }
 
  private:
+  // The landmark (in range of the camera) that `candidate` is the same surface as, or 0.
+  int sameSurfaceLandmark(const QuadricCandidate& candidate,
+                          const Eigen::Isometry3d& T_map_camera) const;
+
   Params params_;
   QuadricAssociator associator_;
+  LandmarkMerger merger_;
   std::map<int, QuadricLandmark> landmarks_;
+  std::map<int, int> merged_into_;
   std::vector<QuadricCandidate> candidates_;
   int next_landmark_id_ = 1;
   int next_candidate_id_ = 1;

@@ -10,6 +10,13 @@
 //      or an old one seen again: a loop). Only keyframes carry factors; other frames' observations
 //      count towards promotion and observation counts only.
 //   4. On a keyframe, optimise the sliding window (mapping/window.h): bounded cost per frame.
+//   5. After the solve, merge the landmarks of the window that are the same surface as another
+//      landmark (mapping/landmark_merger.h): the merged landmark's window observations and folded
+//      prior move to the survivor, whose estimate is the fusion of both; the merges are reported
+//      (MapperFrameResult::merges) so that callers move what they keep per landmark (the
+//      reconstruction: applyMergesToReconstruction). Candidates that are the same surface as a
+//      landmark join it at promotion (mapping/landmark_registry.h); mergeDuplicates() checks the
+//      whole map (before a map is saved). Not in localisation-only mode.
 // The map frame is the first frame's odom pose (T_map_odom = identity until corrections), unless
 // a saved map was loaded (loadLandmarks below: T_map_odom is then given).
 //
@@ -29,6 +36,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -63,8 +71,12 @@ struct MapperFrameResult {
   MapUpdate update;
   // Window statistics of this frame's optimisation (zeros for non-keyframes).
   WindowStatistics window;
+  // Landmarks merged after this frame's optimisation, in the order they were merged (ids in
+  // `update` are those before the merges: map().mergedInto() resolves them).
+  std::vector<LandmarkMerge> merges;
   double association_seconds = 0.0;   // wall time of association and bookkeeping
   double optimisation_seconds = 0.0;  // wall time of the window optimisation (keyframes)
+  double merge_seconds = 0.0;         // wall time of the duplicate search and merges (keyframes)
 };
 
 class QuadricMapper {
@@ -119,6 +131,11 @@ class QuadricMapper {
   void setLocalizationOnly(bool on);
   bool localizationOnly() const { return localization_only_; }
 
+  // Merges every pair of landmarks of the map that are the same surface, repeatedly until none
+  // is left (call it before saving a map). Returns the merges in order; none in localisation-only
+  // mode or with merging disabled.
+  std::vector<LandmarkMerge> mergeDuplicates();
+
   const LandmarkRegistry& map() const { return map_; }
   const SlidingWindow& window() const { return window_; }
   // The landmarks as a list (id order).
@@ -130,6 +147,8 @@ class QuadricMapper {
 
  private:
   Matrix6d incrementCovariance(const Eigen::Isometry3d& T_previous_this) const;
+  // One pass over the duplicate pairs with a member in `subset` (all landmarks when null).
+  std::vector<LandmarkMerge> mergeLandmarks(const std::set<int>* subset);
 
   Params params_;
   LandmarkRegistry map_;
@@ -145,11 +164,17 @@ class QuadricMapper {
 };
 
 // The reconstruction's share of a keyframe, as QuadricSlam and the mapping nodelet compute it: the
-// supporting points of the frame's measurements that went to a landmark (fates kLandmark and
-// kPromoted), seen from result.T_map_camera, added at their landmarks' current estimates in `map`.
+// supporting points of the frame's measurements that went to a landmark (fates kLandmark,
+// kPromoted and kJoined; a landmark merged since is followed to its survivor), seen from
+// result.T_map_camera, added at their landmarks' current estimates in `map`.
 // `frame` holds the measurements given to process() (result.update lists only the accepted ones,
 // in input order). Call it for keyframes. Returns the number of points stored.
 int addKeyframeToReconstruction(const FrameMeasurements& frame, const MapperFrameResult& result,
                                 const LandmarkRegistry& map, QuadricReconstruction* reconstruction);
+
+// Moves the reconstruction points of each merged landmark to its survivor, in the order of
+// `merges` (QuadricReconstruction::moveLandmark).
+void applyMergesToReconstruction(const std::vector<LandmarkMerge>& merges,
+                                 QuadricReconstruction* reconstruction);
 
 }  // namespace quadric_slam

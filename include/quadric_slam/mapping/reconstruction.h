@@ -44,6 +44,10 @@ class QuadricReconstruction {
   int addPoints(int id, const QuadricModel& landmark_map, const Eigen::Isometry3d& T_map_camera,
                 const std::vector<Eigen::Vector3f>& points_camera);
 
+  // Landmark `from` was merged into `to` (mapping/landmark_merger.h): its points join `to`'s,
+  // re-expressed with T_to_from (from's quadric frame in to's), one per voxel of to's frame and
+  // within max_points_per_landmark; `from` has no points afterwards.
+  void moveLandmark(int from, int to, const Eigen::Isometry3d& T_to_from);
   void removeLandmark(int id);
   void clear();
 

@@ -122,6 +122,16 @@ class SlidingWindow {
     return all_landmarks_fixed_ || fixed_landmarks_.count(landmark_id) > 0;
   }
 
+  // Landmark merged_id was merged into survivor_id (mapping/landmark_merger.h): its observations
+  // in the window keyframes become the survivor's (the same measurements, now factors on the
+  // survivor), and its folded prior is fused into the survivor's (surface_fusion.h: information
+  // added, means combined; a prior of the merged landmark alone is re-expressed in the frame of
+  // survivor_estimate, the survivor's estimate in the map). A fixed merged landmark makes the
+  // survivor fixed.
+  void mergeLandmark(int merged_id, int survivor_id, const QuadricModel& survivor_estimate);
+  // The landmarks with at least one observation in the window.
+  std::set<int> landmarkIds() const;
+
   void clear();
 
   const Params& params() const { return params_; }

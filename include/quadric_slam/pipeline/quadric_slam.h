@@ -11,9 +11,10 @@
 //   4. quadric segmentation (frontend/quadric_segmenter.h), unless odometry only;
 //   5. odometry (odometry/odometry_tracker.h);
 //   6. mapping (mapping/quadric_mapper.h) once odometry is initialised, and on keyframes the
-//      supporting points of the landmark observations into the reconstruction. A frame whose
-//      odometry is lost reaches no mapper; after a loss the mapper localises only until the
-//      surfaces anchor the pose in the map again (mapping/tracking_recovery.h).
+//      supporting points of the landmark observations into the reconstruction (after moving the
+//      points of landmarks the mapper merged). A frame whose odometry is lost reaches no mapper;
+//      after a loss the mapper localises only until the surfaces anchor the pose in the map again
+//      (mapping/tracking_recovery.h).
 // Every stage is timed under its name (timer()): normals, segmentation, odometry, mapping,
 // reconstruction.
 #pragma once
@@ -23,6 +24,7 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include "quadric_slam/eval/stage_timing.h"
 #include "quadric_slam/frontend/frame.h"
@@ -85,6 +87,9 @@ class QuadricSlam {
 
   // Forgets odometry, map and reconstruction (landmark ids keep counting).
   void reset();
+  // Merges every pair of landmarks that are the same surface (QuadricMapper::mergeDuplicates) and
+  // moves their reconstruction points to the survivors; call it before saving the map.
+  std::vector<LandmarkMerge> mergeDuplicateLandmarks();
 
   const SlamParams& params() const { return params_; }
   const QuadricMapper& mapper() const { return mapper_; }

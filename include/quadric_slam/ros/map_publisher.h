@@ -6,6 +6,7 @@
 #include <ros/publisher.h>
 #include <std_msgs/Header.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -21,7 +22,10 @@ class QuadricMapPublisher {
   QuadricMapPublisher(ros::NodeHandle& nh, const std::string& map_topic,
                       const std::string& markers_topic, const MarkerStyle& style = MarkerStyle());
 
-  void publish(const std::vector<QuadricLandmark>& landmarks, const std_msgs::Header& header);
+  // merged_into: landmark id merged away -> the landmark holding its surface now
+  // (LandmarkRegistry::mergedInto), published as QuadricMap.merged_ids / merged_into.
+  void publish(const std::vector<QuadricLandmark>& landmarks, const std_msgs::Header& header,
+               const std::map<int, int>& merged_into = {});
 
  private:
   MarkerStyle style_;

@@ -1,5 +1,6 @@
 // LandmarkRegistry: a surface becomes a landmark only after min_observations (5) frames, a
-// detection seen 1-4 times never does and expires, ids are fresh, stable and never reused.
+// detection seen 1-4 times never does and expires, ids are fresh, stable and never reused; a
+// candidate of a landmark's surface joins it at promotion; merges are recorded for subscribers.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -138,6 +139,74 @@ TEST(LandmarkRegistry, IdsAreStableAndNeverReused) {
     map.integrate(frame, frame * 0.1, {test::measure(a, kCamera, rng)}, kCamera, Matrix6d::Zero());
   ASSERT_EQ(map.landmarks().size(), 1u);
   EXPECT_GT(map.landmarks().begin()->first, std::max(ids_a.front(), ids_b.front()));
+}
+
+// A floor the segmenter reports in two fragments every frame: association is one-to-one, so the
+// second fragment builds a candidate of its own; at promotion it is the landmark's surface and
+// joins it (fate kJoined, its history handed over) instead of becoming a second landmark.
+TEST(LandmarkRegistry, CandidateOfALandmarksSurfaceJoinsIt) {
+  for (const bool merging : {true, false}) {
+    LandmarkRegistry::Params p;
+    p.merging.enabled = merging;
+    LandmarkRegistry map(p);
+    std::mt19937 rng(50);
+    const Eigen::Vector3d Z = Eigen::Vector3d::UnitZ(), X = Eigen::Vector3d::UnitX();
+    // Two fragments of the floor z = 0 meeting at x = 0.5, each in a frame of its own.
+    const test::TrueLandmark near = test::plane(Eigen::Vector3d(0.0, 0, 0), Z, X, 0.5, 1.0);
+    const test::TrueLandmark far = test::plane(Eigen::Vector3d(1.02, 0, 0), Z, X, 0.5, 1.0);
+    MapUpdate u;
+    for (int frame = 1; frame <= 5; ++frame)
+      u = map.integrate(frame, 0.1 * frame,
+                        {test::measure(near, kCamera, rng), test::measure(far, kCamera, rng)},
+                        kCamera, Matrix6d::Zero());
+    if (!merging) {
+      EXPECT_EQ(u.promoted.size(), 2u);
+      EXPECT_EQ(map.landmarks().size(), 2u);
+      EXPECT_TRUE(u.joined.empty());
+      continue;
+    }
+    ASSERT_EQ(u.promoted.size(), 1u);
+    const int id = u.promoted[0];
+    ASSERT_EQ(map.landmarks().size(), 1u);
+    ASSERT_EQ(u.joined.size(), 1u);
+    EXPECT_EQ(u.joined[0].landmark_id, id);
+    EXPECT_EQ(u.joined[0].history.size(), 5u);
+    EXPECT_EQ(u.measurements[0].id, id);
+    EXPECT_EQ(u.measurements[1].id, id);
+    EXPECT_TRUE((u.measurements[0].fate == MeasurementFate::kPromoted) !=
+                (u.measurements[1].fate == MeasurementFate::kPromoted));
+    EXPECT_TRUE(u.measurements[0].fate == MeasurementFate::kJoined ||
+                u.measurements[1].fate == MeasurementFate::kJoined);
+    EXPECT_EQ(map.landmark(id).observations, 10);
+    // The landmark's extent spans both fragments (world x from -0.5 to 1.52).
+    const QuadricLandmark& l = map.landmark(id);
+    const ExtentBox world = ExtentBox{l.extent_min, l.extent_max}.transformed(l.quadric_map.pose());
+    EXPECT_LT(world.min.x(), -0.45);
+    EXPECT_GT(world.max.x(), 1.45);
+    EXPECT_TRUE(map.candidates().empty());
+  }
+}
+
+TEST(LandmarkRegistry, AbsorbedLandmarksAreRecordedWithChainsResolved) {
+  LandmarkRegistry map;
+  for (int id : {3, 5, 8}) {
+    QuadricLandmark l;
+    l.id = id;
+    l.observations = id;
+    map.insertLandmark(l);
+  }
+  QuadricLandmark survivor = map.landmark(5);
+  survivor.observations = 8;
+  map.absorbLandmark(3, survivor);
+  EXPECT_EQ(map.landmarks().count(3), 0u);
+  EXPECT_EQ(map.landmark(5).observations, 8);
+  EXPECT_EQ(map.mergedInto(), (std::map<int, int>{{3, 5}}));
+  map.absorbLandmark(5, map.landmark(8));
+  EXPECT_EQ(map.mergedInto(), (std::map<int, int>{{3, 8}, {5, 8}}));
+  EXPECT_THROW(map.absorbLandmark(5, map.landmark(8)), std::out_of_range);
+  EXPECT_THROW(map.absorbLandmark(8, map.landmark(8)), std::invalid_argument);
+  map.clear();
+  EXPECT_TRUE(map.mergedInto().empty());
 }
 
 }  // namespace

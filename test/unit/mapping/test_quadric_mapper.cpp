@@ -2,7 +2,9 @@
 // 0.005 rad / 2% of scale; odometry with a 2% scale error and a 1 mrad-per-frame yaw bias):
 // the trajectory is much better than the drifting odometry and the landmarks converge; the window
 // problem stays bounded while the map grows; bad input is refused without touching the map; a
-// saved map is loaded (loadLandmarks) to localise against it unchanged or to extend it.
+// saved map is loaded (loadLandmarks) to localise against it unchanged or to extend it; each
+// surface is mapped once (a wall reported in fragments is one landmark, two table tops at one
+// height stay two, landmarks found to be one surface later are merged and their ids reported).
 #include <gtest/gtest.h>
 
 #include <iostream>
@@ -427,6 +429,221 @@ TEST(QuadricMapper, LoadLandmarksRefusesBadInputAndKeepsTheMap) {
   mapper.loadLandmarks({}, true);
   EXPECT_TRUE(mapper.landmarks().empty());
   EXPECT_TRUE(mapper.window().keyframes().empty());
+}
+
+// --- Each surface once (mapping/landmark_merger.h) ----------------------------------------------
+
+const Eigen::Vector3d kUnitX = Eigen::Vector3d::UnitX(), kUnitY = Eigen::Vector3d::UnitY(),
+                      kUnitZ = Eigen::Vector3d::UnitZ();
+
+// A piece of the wall x = 3 (normal -x) over world y in [y0, y1], z in [z0, z1], in a frame of its
+// own: the segmenter reports a large surface as such fragments.
+test::TrueLandmark wallPiece(double y0, double y1, double z0 = 0.0, double z1 = 2.5) {
+  return test::plane(Eigen::Vector3d(3.0, 0.5 * (y0 + y1), 0.5 * (z0 + z1)), -kUnitX, kUnitY,
+                     0.5 * (y1 - y0), 0.5 * (z1 - z0));
+}
+
+// Points on a surface piece on a 5 cm grid of its extent (planes: the y-z plane of the frame),
+// in the camera frame: the measurement's supporting points for the reconstruction.
+std::vector<Eigen::Vector3f> planePoints(const test::TrueLandmark& piece,
+                                         const Eigen::Isometry3d& T_world_camera) {
+  std::vector<Eigen::Vector3f> points;
+  const Eigen::Isometry3d T_camera_quadric = T_world_camera.inverse() * piece.quadric_world.pose();
+  for (double y = piece.extent.min.y(); y <= piece.extent.max.y(); y += 0.05)
+    for (double z = piece.extent.min.z(); z <= piece.extent.max.z(); z += 0.05)
+      points.push_back((T_camera_quadric * Eigen::Vector3d(0, y, z)).cast<float>());
+  return points;
+}
+
+// The camera 3 m from the wall at 1.3 m height, looking at it (+x) and a little down, sliding
+// along y from y_from to y_to over `frames` frames.
+std::vector<Eigen::Isometry3d> slideAlongWall(int frames, double y_from, double y_to) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < frames; ++i) {
+    const double y = y_from + (y_to - y_from) * i / std::max(frames - 1, 1);
+    poses.push_back(test::lookAlong(Eigen::Vector3d(0, y, 1.3), Eigen::Vector3d(1, 0, -0.25)));
+  }
+  return poses;
+}
+
+// Frame by frame: the pieces of `pieces_per_frame[i]` measured from poses[i] (with supporting
+// points), the odometry (drifting, or exact), the mapper, and the reconstruction as QuadricSlam
+// grows it (merges first, then the keyframe's points).
+struct ScriptedRun {
+  std::vector<MapperFrameResult> frames;
+  QuadricReconstruction reconstruction;
+};
+ScriptedRun runScript(QuadricMapper* mapper, const std::vector<Eigen::Isometry3d>& poses,
+                      const std::vector<std::vector<test::TrueLandmark>>& pieces_per_frame,
+                      bool drifting_odometry, int seed) {
+  std::mt19937 rng(seed);
+  std::vector<Eigen::Isometry3d> odometry;  // from the identity, as the front-end's
+  if (drifting_odometry)
+    odometry = test::driftingOdometry(poses, rng);
+  else
+    for (const Eigen::Isometry3d& pose : poses)
+      odometry.push_back(poses.front().inverse() * pose);
+  ScriptedRun out;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    FrameMeasurements frame;
+    frame.stamp = 1.0 + i / 30.0;
+    for (const test::TrueLandmark& piece : pieces_per_frame[i]) {
+      frame.observations.push_back(test::measure(piece, poses[i], rng));
+      if (piece.quadric_world.quadricClass() == QuadricClass::kPlane)
+        frame.observations.back().support_points = planePoints(piece, poses[i]);
+    }
+    OdometryInput odom;
+    odom.T_odom_camera = odometry[i];
+    const MapperFrameResult r = mapper->process(frame, odom);
+    EXPECT_EQ(r.status, FrameStatus::kOk) << r.message;
+    if (r.keyframe) {
+      applyMergesToReconstruction(r.merges, &out.reconstruction);
+      addKeyframeToReconstruction(frame, r, mapper->map(), &out.reconstruction);
+    }
+    out.frames.push_back(r);
+  }
+  return out;
+}
+
+// The landmarks that are planes with normal +-n and offset within 2 cm of `offset` along n, in
+// the world frame (the map frame is the first camera pose, T_world_map).
+std::vector<int> planesAt(const QuadricMapper& mapper, const Eigen::Isometry3d& T_world_map,
+                          const Eigen::Vector3d& n, double offset) {
+  std::vector<int> ids;
+  for (const QuadricLandmark& l : mapper.landmarks()) {
+    if (l.quadric_map.quadricClass() != QuadricClass::kPlane)
+      continue;
+    const PlaneShape shape = planeShape(l.quadric_map.transformed(T_world_map));
+    const double sign = shape.normal.dot(n) > 0 ? 1.0 : -1.0;
+    if (std::abs(shape.normal.dot(n)) > 0.99 && std::abs(sign * shape.offset - offset) < 0.02)
+      ids.push_back(l.id);
+  }
+  return ids;
+}
+
+// The segmenter cuts the back wall into three pieces in every frame (occluders in front of it),
+// and association is one-to-one, so two pieces start candidates of their own each time. With
+// merging the wall is one landmark after 20 frames; without it is three or more.
+TEST(QuadricMapper, WallSeenAsThreeFragmentsOverTwentyFramesIsOneLandmark) {
+  const std::vector<Eigen::Isometry3d> poses = slideAlongWall(20, -0.3, 0.3);
+  const test::TrueLandmark floor =
+      test::plane(Eigen::Vector3d(1.5, 0, 0), kUnitZ, kUnitX, 1.5, 2.0);
+  const test::TrueLandmark ball = test::sphere(Eigen::Vector3d(2.0, 0.8, 0.3), 0.2);
+  const std::vector<test::TrueLandmark> pieces = {wallPiece(-2.0, -0.72), wallPiece(-0.66, 0.6),
+                                                  wallPiece(0.65, 2.0), floor, ball};
+  for (const bool merging : {true, false}) {
+    QuadricMapper::Params p;
+    p.map.merging.enabled = merging;
+    QuadricMapper mapper(p);
+    const ScriptedRun run = runScript(
+        &mapper, poses, std::vector<std::vector<test::TrueLandmark>>(20, pieces), true, 61);
+    const std::vector<int> wall = planesAt(mapper, poses[0], kUnitX, 3.0);
+    if (merging) {
+      EXPECT_EQ(wall.size(), 1u);
+      EXPECT_EQ(planesAt(mapper, poses[0], kUnitZ, 0.0).size(), 1u);
+      EXPECT_EQ(mapper.landmarks().size(), 3u);  // wall, floor, ball
+      EXPECT_TRUE(mapper.mergeDuplicates().empty());
+      // Its extent spans the whole wall.
+      ASSERT_EQ(wall.size(), 1u);
+      const QuadricLandmark& l = mapper.map().landmark(wall[0]);
+      const ExtentBox world =
+          ExtentBox{l.extent_min, l.extent_max}.transformed(poses[0] * l.quadric_map.pose());
+      EXPECT_LT(world.min.y(), -1.9);
+      EXPECT_GT(world.max.y(), 1.9);
+    } else {
+      EXPECT_GE(wall.size(), 3u);
+    }
+  }
+}
+
+// Two table tops at one height, 2 m apart (0.8 m wide, centres 2.8 m apart; the same infinite
+// plane): two landmarks, also after the whole-map merge before saving. (With only 1.2 m between
+// them, association itself joins them: the synthetic measurements are expressed in frames turned
+// at random about the normal, whose axis-aligned boxes are up to 1.4 times wider, and association
+// grows each box by 0.25 m.)
+TEST(QuadricMapper, TwoTablesAtOneHeightTwoMetresApartStayTwoLandmarks) {
+  const std::vector<Eigen::Isometry3d> poses = slideAlongWall(20, -0.3, 0.3);
+  const test::TrueLandmark left =
+      test::plane(Eigen::Vector3d(2.0, -1.4, 0.75), kUnitZ, kUnitX, 0.4, 0.4);
+  const test::TrueLandmark right =
+      test::plane(Eigen::Vector3d(2.0, 1.4, 0.75), kUnitZ, kUnitX, 0.4, 0.4);
+  const test::TrueLandmark floor =
+      test::plane(Eigen::Vector3d(1.5, 0, 0), kUnitZ, kUnitX, 1.5, 2.0);
+  QuadricMapper mapper;
+  runScript(
+      &mapper, poses,
+      std::vector<std::vector<test::TrueLandmark>>(20, {left, right, floor, wallPiece(-2, 2)}),
+      true, 62);
+  EXPECT_TRUE(mapper.mergeDuplicates().empty());
+  const std::vector<int> tables = planesAt(mapper, poses[0], kUnitZ, 0.75);
+  ASSERT_EQ(tables.size(), 2u);
+  EXPECT_TRUE(mapper.map().mergedInto().empty());
+  // One on each side.
+  auto centreY = [&](int id) {
+    const QuadricLandmark& l = mapper.map().landmark(id);
+    const ExtentBox world =
+        ExtentBox{l.extent_min, l.extent_max}.transformed(poses[0] * l.quadric_map.pose());
+    return 0.5 * (world.min.y() + world.max.y());
+  };
+  EXPECT_LT(centreY(tables[0]) * centreY(tables[1]), 0.0);
+}
+
+// The left and the right part of a wall are seen first (1 m apart: two landmarks), then its middle,
+// which joins one of them and makes the extents touch: the window solve is followed by a merge,
+// reported in the frame's result and in the map's record, and the merged landmark's
+// reconstruction points move to the survivor.
+TEST(QuadricMapper, LandmarksFoundToBeOneSurfaceAreMergedAndReported) {
+  const test::TrueLandmark floor =
+      test::plane(Eigen::Vector3d(1.5, 0, 0), kUnitZ, kUnitX, 1.5, 2.0);
+  // The parts are 4 m apart: the synthetic measurements come in frames turned at random about the
+  // normal, whose axis-aligned boxes (moved twice, into the candidate's and the landmark's frame)
+  // are up to twice as wide, and association grows boxes by 0.25 m.
+  std::vector<std::vector<test::TrueLandmark>> pieces;
+  for (int i = 0; i < 36; ++i) {
+    if (i < 12)
+      pieces.push_back({wallPiece(-3.5, -2.0, 0.5, 2.0), floor});
+    else if (i < 24)
+      pieces.push_back({wallPiece(2.0, 3.5, 0.5, 2.0), floor});
+    else
+      pieces.push_back({wallPiece(-2.2, 2.2, 0.5, 2.0), floor});
+  }
+  QuadricMapper mapper;
+  // Exact odometry: the two parts are estimated from different frames, and a drift the walls and
+  // the floor cannot observe (yaw, sliding along the wall) would tell them apart.
+  const std::vector<Eigen::Isometry3d> poses = slideAlongWall(36, -0.3, 0.3);
+  ScriptedRun run = runScript(&mapper, poses, pieces, false, 63);
+  std::vector<LandmarkMerge> merges;
+  for (const MapperFrameResult& f : run.frames)
+    merges.insert(merges.end(), f.merges.begin(), f.merges.end());
+  ASSERT_EQ(merges.size(), 1u);
+  const LandmarkMerge& m = merges[0];
+  EXPECT_EQ(mapper.map().mergedInto(), (std::map<int, int>{{m.merged_id, m.survivor_id}}));
+  EXPECT_EQ(mapper.map().landmarks().count(m.merged_id), 0u);
+  const std::vector<int> wall = planesAt(mapper, poses[0], kUnitX, 3.0);
+  EXPECT_EQ(wall, std::vector<int>{m.survivor_id});
+  // Reconstruction: the merged id has no points; the survivor's cover both parts of the wall.
+  EXPECT_EQ(run.reconstruction.size(m.merged_id), 0u);
+  std::map<int, QuadricModel> surfaces;
+  for (const QuadricLandmark& l : mapper.landmarks())
+    surfaces[l.id] = l.quadric_map;
+  double min_y = 1e9, max_y = -1e9;
+  for (const auto& p : run.reconstruction.cloud(surfaces)) {
+    EXPECT_NE(p.label, static_cast<std::uint32_t>(m.merged_id));
+    if (p.label == static_cast<std::uint32_t>(m.survivor_id)) {
+      const double y = (poses[0] * p.getVector3fMap().cast<double>()).y();
+      min_y = std::min(min_y, y);
+      max_y = std::max(max_y, y);
+    }
+  }
+  EXPECT_LT(min_y, -3.0);
+  EXPECT_GT(max_y, 3.0);
+  // Nothing is merged when merging is off: the two parts stay.
+  QuadricMapper::Params off;
+  off.map.merging.enabled = false;
+  QuadricMapper unmerged(off);
+  runScript(&unmerged, poses, pieces, false, 63);
+  EXPECT_EQ(planesAt(unmerged, poses[0], kUnitX, 3.0).size(), 2u);
+  EXPECT_TRUE(unmerged.map().mergedInto().empty());
 }
 
 }  // namespace

@@ -170,3 +170,58 @@ TEST(QuadricReconstruction, ParamsValidateNamesTheField) {
   params.max_surface_distance = -1.0;
   EXPECT_THROW(params.validate(), std::invalid_argument);
 }
+
+// A landmark merged into another (mapping/landmark_merger.h): its points join the survivor's at
+// the same map positions, one per voxel, and the merged id has none left.
+TEST(QuadricReconstruction, MovedLandmarkPointsKeepTheirPlaceInTheMap) {
+  const Eigen::Isometry3d T_map_camera = cameraPose();
+  // One floor z = 0 as two landmarks: frames at the origin and at (2, 0, 0) turned about the
+  // normal.
+  qs::PlaneShape shape;
+  shape.normal = Eigen::Vector3d::UnitZ();
+  const qs::QuadricModel floor_a = qs::quadricFromShape(shape);
+  const qs::QuadricModel floor_b(
+      qs::QuadricClass::kPlane,
+      qs::makeIsometry(floor_a.pose().linear() *
+                           Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitX()).toRotationMatrix(),
+                       Eigen::Vector3d(2, 0, 0)),
+      Eigen::Vector3d::Ones());
+  std::vector<Eigen::Vector3f> points_a, points_b;
+  std::vector<Eigen::Vector3d> b_map;
+  for (int i = 0; i < 20; ++i) {
+    for (int j = 0; j < 10; ++j) {
+      // In the middle of voxels (5 mm above the floor, 5 mm off the grid lines), so that float
+      // rounding of the stored points cannot move them across a voxel boundary.
+      const Eigen::Vector3d pa(0.005 + 0.05 * i, 0.005 + 0.05 * j, 0.005),
+          pb(1.505 + 0.05 * i, 0.005 + 0.05 * j, 0.005);
+      points_a.push_back((T_map_camera.inverse() * pa).cast<float>());
+      points_b.push_back((T_map_camera.inverse() * pb).cast<float>());
+      b_map.push_back(pb - Eigen::Vector3d(0, 0, 0.005));  // where the cloud projects it
+    }
+  }
+  qs::QuadricReconstruction reconstruction;
+  ASSERT_EQ(reconstruction.addPoints(1, floor_a, T_map_camera, points_a), 200);
+  ASSERT_EQ(reconstruction.addPoints(2, floor_b, T_map_camera, points_b), 200);
+  const Eigen::Isometry3d T_a_b = floor_a.pose().inverse() * floor_b.pose();
+  reconstruction.moveLandmark(2, 1, T_a_b);
+  EXPECT_EQ(reconstruction.size(2), 0u);
+  // x in [0, 0.95] and [1.5, 2.45]: no voxel in common.
+  EXPECT_EQ(reconstruction.size(1), 400u);
+  const auto cloud = reconstruction.cloud({{1, floor_a}});
+  ASSERT_EQ(cloud.size(), 400u);
+  for (const Eigen::Vector3d& p : b_map) {
+    double nearest = 1e9;
+    for (const auto& q : cloud)
+      nearest = std::min(nearest, (q.getVector3fMap().cast<double>() - p).norm());
+    EXPECT_LT(nearest, 1e-5);
+  }
+  for (const auto& q : cloud)
+    EXPECT_EQ(q.label, 1u);
+  // Moving the same points again adds nothing (one per voxel); an unknown id is a no-op.
+  ASSERT_EQ(reconstruction.addPoints(3, floor_a, T_map_camera, points_a), 200);
+  reconstruction.moveLandmark(3, 1, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(reconstruction.size(1), 400u);
+  EXPECT_EQ(reconstruction.size(3), 0u);
+  reconstruction.moveLandmark(42, 1, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(reconstruction.size(1), 400u);
+}

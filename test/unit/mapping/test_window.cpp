@@ -1,6 +1,7 @@
 // SlidingWindow: the gauge (first keyframe fixed, later the oldest pose held by a prior), a small
 // window converging to the truth, sliding (size bound, landmarks leaving keep their estimate) and
-// the folded landmark priors taking over when a landmark is seen again.
+// the folded landmark priors taking over when a landmark is seen again; a merged landmark's
+// observations and prior moving to the survivor.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -200,6 +201,54 @@ TEST(SlidingWindow, FoldedPriorKeepsTheHistory) {
             << " m, with 9 folded keyframes " << with_history << " m\n";
   EXPECT_GT(without_history, 0.005);
   EXPECT_LT(with_history, 0.3 * without_history);
+}
+
+// A landmark merged into another (mapping/landmark_merger.h): its observations in the window
+// become factors on the survivor, its folded prior goes with them, and the next solve has one
+// block for the surface.
+TEST(SlidingWindow, MergedLandmarkObservationsMoveToTheSurvivor) {
+  const test::TrueLandmark floor = test::plane(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d::UnitZ(),
+                                               Eigen::Vector3d::UnitX(), 3, 3);
+  const test::TrueLandmark ball = test::sphere(Eigen::Vector3d(0, -0.5, 0.3), 0.25);
+  const std::vector<Eigen::Isometry3d> poses = cameraLine(6);
+  std::mt19937 rng(53);
+  LandmarkRegistry map(immediateLandmarks());
+  for (int id : {1, 2}) {  // the floor twice (two fragments that became landmarks)
+    QuadricLandmark l;
+    l.id = id;
+    l.quadric_map = floor.quadric_world;
+    l.extent_min = floor.extent.min;
+    l.extent_max = floor.extent.max;
+    map.insertLandmark(l);
+  }
+  QuadricLandmark l3;
+  l3.id = 3;
+  l3.quadric_map = ball.quadric_world;
+  map.insertLandmark(l3);
+  SlidingWindow::Params p;
+  p.size = 4;  // two keyframes leave: landmark 2's observations are folded into a prior
+  SlidingWindow window(p);
+  for (int i = 0; i < 6; ++i) {
+    Keyframe kf = keyframeAt(i + 1, poses[i], poses[std::max(i - 1, 0)], poses[i]);
+    kf.observations.push_back({1, test::measure(floor, poses[i], rng)});
+    kf.observations.push_back({2, test::measure(floor, poses[i], rng)});
+    kf.observations.push_back({3, test::measure(ball, poses[i], rng)});
+    window.addKeyframe(kf, map);
+  }
+  EXPECT_EQ(window.optimize(&map).landmark_priors, 3);
+  window.mergeLandmark(2, 1, map.landmark(1).quadric_map);
+  map.absorbLandmark(2, map.landmark(1));
+  EXPECT_FALSE(window.containsLandmark(2));
+  EXPECT_EQ(window.landmarkIds(), (std::set<int>{1, 3}));
+  for (const Keyframe& kf : window.keyframes())
+    for (const WindowObservation& o : kf.observations)
+      EXPECT_NE(o.landmark_id, 2);
+  const WindowStatistics s = window.optimize(&map);
+  EXPECT_TRUE(s.solution_usable);
+  EXPECT_EQ(s.landmark_blocks, 2);
+  EXPECT_EQ(s.observation_factors, 12);  // 4 keyframes x 3 observations, now on 2 landmarks
+  EXPECT_EQ(s.landmark_priors, 2);       // landmark 2's prior fused into landmark 1's
+  EXPECT_LT(surfaceMinus(map.landmark(1).quadric_map, floor.quadric_world).norm(), 0.01);
 }
 
 }  // namespace
