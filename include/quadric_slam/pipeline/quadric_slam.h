@@ -11,7 +11,8 @@
 //   4. quadric segmentation (frontend/quadric_segmenter.h), unless odometry only;
 //   5. odometry (odometry/odometry_tracker.h);
 //   6. mapping (mapping/quadric_mapper.h) once odometry is initialised, and on keyframes the
-//      supporting points of the landmark observations into the reconstruction.
+//      supporting points of the landmark observations into the reconstruction, coloured from
+//      frame.rgb when the frame has one (frontend/support_colours.h: RGB registered to depth).
 // Every stage is timed under its name (timer()): normals, segmentation, odometry, mapping,
 // reconstruction.
 #pragma once
@@ -64,7 +65,7 @@ struct SlamFrameResult {
   bool processed = false;  // false: skipped (message says why), nothing changed
   std::string message;     // why the frame was skipped, or what a stage refused
   OdometryTracker::Result odometry;
-  bool tracking = false;  // odometry is initialised (odometry.T_odom_camera is meaningful)
+  bool tracking = false;           // odometry is initialised (odometry.T_odom_camera is meaningful)
   FrameMeasurements measurements;  // the segmentation's observations (camera frame)
   bool mapped = false;             // the mapper accepted the frame (mapping is meaningful)
   MapperFrameResult mapping;
@@ -83,8 +84,9 @@ class QuadricSlam {
   const QuadricMapper& mapper() const { return mapper_; }
   const OdometryTracker& odometry() const { return odometry_; }
   const QuadricReconstruction& reconstruction() const { return reconstruction_; }
-  // The landmarks' points on their current surfaces, label = landmark id.
-  pcl::PointCloud<pcl::PointXYZL> reconstructionCloud() const;
+  // The landmarks' points on their current surfaces, label = landmark id, rgba = the colour of the
+  // pixel the point came from when the frames had RGB (alpha 0: uncoloured).
+  pcl::PointCloud<pcl::PointXYZRGBL> reconstructionCloud() const;
   // The latest frame's organized cloud with normals, and its segmentation (labels per point).
   const pcl::PointCloud<pcl::PointNormal>& cloud() const { return cloud_; }
   const Segmentation& segmentation() const { return segmentation_; }
