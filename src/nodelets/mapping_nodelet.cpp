@@ -145,7 +145,7 @@ class MappingNodelet : public nodelet::Nodelet {
     int queue_size = 10;
     double diagnostic_period = 1.0;
     bool localization_only = false;
-    int rgb_buffer_size = 30;
+    int rgb_buffer_size = 60;
     double rgb_max_stamp_difference = 0.02;
     try {
       const RosParamReader reader(private_nh);
@@ -161,6 +161,7 @@ class MappingNodelet : public nodelet::Nodelet {
       readParam(reader, "use_rgb", use_rgb_, log);
       readParam(reader, "rgb_buffer_size", rgb_buffer_size, log);
       readParam(reader, "rgb_max_stamp_difference", rgb_max_stamp_difference, log);
+      rgb_max_stamp_difference_ = rgb_max_stamp_difference;
       if (rgb_buffer_size < 1)
         throw std::invalid_argument("rgb_buffer_size must be >= 1");
       colour_images_ = std::make_unique<ColourImageBuffer>(
@@ -278,6 +279,17 @@ class MappingNodelet : public nodelet::Nodelet {
   void colourFrame(FrameMeasurements& frame, const ros::Time& stamp) {
     ColourImageBuffer::Entry image;
     bool coloured = colour_images_->nearest(stamp.toSec(), &image);
+    if (!coloured) {
+      double oldest = 0.0, newest = 0.0;
+      rgb_drops_.report(colour_images_->span(&oldest, &newest)
+                            ? (stamp.toSec() < oldest
+                                   ? "the observations are older than every buffered colour "
+                                     "image (raise ~rgb_buffer_size)"
+                                   : "no colour image within ~rgb_max_stamp_difference of "
+                                     "the observations")
+                            : "no colour image received on rgb/image yet");
+    }
+    colour_images_->dropBefore(stamp.toSec() - rgb_max_stamp_difference_);
     if (coloured) {
       try {
         colourSupportPoints(frame, image.rgb->image, image.intrinsics);
@@ -767,6 +779,7 @@ class MappingNodelet : public nodelet::Nodelet {
   int max_path_poses_ = 10000;
   std::string map_file_;
   bool use_rgb_ = false;
+  double rgb_max_stamp_difference_ = 0.02;  // s
 
   // State (mutex_): the core objects and what the outputs need.
   std::mutex mutex_;

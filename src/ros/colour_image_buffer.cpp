@@ -55,6 +55,21 @@ bool ColourImageBuffer::nearest(double stamp, Entry* out) const {
   return true;
 }
 
+void ColourImageBuffer::dropBefore(double stamp) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  while (!entries_.empty() && entries_.front().stamp < stamp)
+    entries_.pop_front();
+}
+
+bool ColourImageBuffer::span(double* oldest, double* newest) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (entries_.empty())
+    return false;
+  *oldest = entries_.front().stamp;
+  *newest = entries_.back().stamp;
+  return true;
+}
+
 void ColourImageBuffer::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   entries_.clear();

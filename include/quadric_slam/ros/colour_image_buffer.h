@@ -43,6 +43,11 @@ class ColourImageBuffer {
   void add(Entry entry);
   // The entry nearest to stamp when within the gate; false otherwise (*out untouched).
   bool nearest(double stamp, Entry* out) const;
+  // Forgets the images older than stamp (observations come in stamp order: an image older than
+  // the latest observation's stamp minus the gate can no longer match).
+  void dropBefore(double stamp);
+  // Stamps of the oldest and newest image (s); false when empty.
+  bool span(double* oldest, double* newest) const;
   void clear();
   std::size_t size() const;
 

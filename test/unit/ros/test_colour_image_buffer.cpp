@@ -48,6 +48,13 @@ TEST(ColourImageBuffer, FindsTheNearestImageWithinTheGate) {
   EXPECT_FALSE(buffer.nearest(1.000, &found)) << "evicted";
   EXPECT_FALSE(buffer.nearest(1.130, &found)) << "outside the gate";
   EXPECT_DOUBLE_EQ(found.stamp, 1.100) << "untouched when nothing matches";
+  double oldest = 0.0, newest = 0.0;
+  ASSERT_TRUE(buffer.span(&oldest, &newest));
+  EXPECT_DOUBLE_EQ(oldest, 1.033);
+  EXPECT_DOUBLE_EQ(newest, 1.100);
+  buffer.dropBefore(1.05);  // the observations have reached 1.07
+  EXPECT_EQ(buffer.size(), 2u);
+  EXPECT_FALSE(buffer.nearest(1.035, &found));
   buffer.add(entryAt(0.5));  // time went backwards: the older images are gone
   EXPECT_EQ(buffer.size(), 1u);
   EXPECT_FALSE(buffer.nearest(1.100, &found));
