@@ -150,6 +150,8 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
       valid.push_back(measurement);
       valid.back().support_points.clear();
       valid.back().support_points.shrink_to_fit();
+      valid.back().support_colours.clear();
+      valid.back().support_colours.shrink_to_fit();
       continue;
     }
     ++result.rejected_measurements;
@@ -323,7 +325,8 @@ int addKeyframeToReconstruction(const FrameMeasurements& frame, const MapperFram
     const auto landmark = map.landmarks().find(id);
     if (landmark != map.landmarks().end())
       stored += reconstruction->addPoints(id, landmark->second.quadric_map, result.T_map_camera,
-                                          measurement.support_points);
+                                          measurement.support_points,
+                                          measurement.support_colours);
   }
   return stored;
 }

@@ -38,12 +38,18 @@ std::uint64_t QuadricReconstruction::voxelKey(const Eigen::Vector3d& p_quadric) 
 
 int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
                                      const Eigen::Isometry3d& T_map_camera,
-                                     const std::vector<Eigen::Vector3f>& points_camera) {
+                                     const std::vector<Eigen::Vector3f>& points_camera,
+                                     const std::vector<std::uint32_t>& colours_rgba) {
+  if (!colours_rgba.empty() && colours_rgba.size() != points_camera.size())
+    throw std::invalid_argument(
+        "QuadricReconstruction::addPoints: " + std::to_string(colours_rgba.size()) +
+        " colours for " + std::to_string(points_camera.size()) + " points");
   LandmarkPoints& stored = landmarks_[id];
   const Eigen::Isometry3d T_quadric_camera = landmark_map.pose().inverse() * T_map_camera;
   const bool exact = landmark_map.quadricClass() != QuadricClass::kGeneral;
   int added = 0;
-  for (const Eigen::Vector3f& point : points_camera) {
+  for (std::size_t i = 0; i < points_camera.size(); ++i) {
+    const Eigen::Vector3f& point = points_camera[i];
     if (static_cast<int>(stored.points_quadric.size()) >= params_.max_points_per_landmark)
       break;
     if (!point.allFinite())
@@ -56,6 +62,10 @@ int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
     const Eigen::Vector3d p_quadric = T_quadric_camera * point.cast<double>();
     if (!stored.voxels.insert(voxelKey(p_quadric)).second)
       continue;
+    if (!colours_rgba.empty() && (colours_rgba[i] >> 24) != 0) {
+      stored.rgba.resize(stored.points_quadric.size(), 0u);  // earlier points stay uncoloured
+      stored.rgba.push_back(colours_rgba[i]);
+    }
     stored.points_quadric.push_back(p_quadric.cast<float>());
     ++added;
   }
@@ -69,12 +79,20 @@ void QuadricReconstruction::moveLandmark(int from, int to, const Eigen::Isometry
   if (from == to || source == landmarks_.end())
     return;
   LandmarkPoints& target = landmarks_[to];
-  for (const Eigen::Vector3f& p_from : source->second.points_quadric) {
+  const LandmarkPoints& moved = source->second;
+  for (std::size_t i = 0; i < moved.points_quadric.size(); ++i) {
     if (static_cast<int>(target.points_quadric.size()) >= params_.max_points_per_landmark)
       break;
-    const Eigen::Vector3d p_to = T_to_from * p_from.cast<double>();
-    if (target.voxels.insert(voxelKey(p_to)).second)
-      target.points_quadric.push_back(p_to.cast<float>());
+    const Eigen::Vector3d p_to = T_to_from * moved.points_quadric[i].cast<double>();
+    if (!target.voxels.insert(voxelKey(p_to)).second)
+      continue;
+    // The colour travels with its point (rgba may be shorter than the points: the tail is
+    // uncoloured).
+    if (i < moved.rgba.size() && (moved.rgba[i] >> 24) != 0) {
+      target.rgba.resize(target.points_quadric.size(), 0u);
+      target.rgba.push_back(moved.rgba[i]);
+    }
+    target.points_quadric.push_back(p_to.cast<float>());
   }
   landmarks_.erase(from);
   if (landmarks_[to].points_quadric.empty())
@@ -101,21 +119,25 @@ std::size_t QuadricReconstruction::size(int id) const {
   return it == landmarks_.end() ? 0 : it->second.points_quadric.size();
 }
 
-pcl::PointCloud<pcl::PointXYZL> QuadricReconstruction::cloud(
+pcl::PointCloud<pcl::PointXYZRGBL> QuadricReconstruction::cloud(
     const std::map<int, QuadricModel>& landmarks_map) const {
-  pcl::PointCloud<pcl::PointXYZL> out;
+  pcl::PointCloud<pcl::PointXYZRGBL> out;
   for (const auto& [id, landmark] : landmarks_map) {
     const auto stored = landmarks_.find(id);
     if (stored == landmarks_.end())
       continue;
-    for (const Eigen::Vector3f& p_quadric : stored->second.points_quadric) {
+    const std::vector<Eigen::Vector3f>& points = stored->second.points_quadric;
+    const std::vector<std::uint32_t>& rgba = stored->second.rgba;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3f& p_quadric = points[i];
       Eigen::Vector3d on_surface;
       try {
         on_surface = projector_.project(landmark, landmark.pose() * p_quadric.cast<double>());
       } catch (const std::invalid_argument&) {
         continue;  // a general quadric whose projection does not converge from here
       }
-      pcl::PointXYZL point;
+      pcl::PointXYZRGBL point;
+      point.rgba = i < rgba.size() ? rgba[i] : 0u;
       point.x = static_cast<float>(on_surface.x());
       point.y = static_cast<float>(on_surface.y());
       point.z = static_cast<float>(on_surface.z());

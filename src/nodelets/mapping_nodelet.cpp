@@ -7,11 +7,20 @@
 //             The observations are taken to be in odom's child frame (the tracked camera); a
 //             frame id that differs gets a throttled warning (normal_estimation's ~output_frame
 //             names the clouds' frame, odometry's ~camera_frame the tracked one: set them equal).
+//             With ~use_rgb: rgb/image (sensor_msgs/Image rgb8, bgr8 or mono8, through
+//             image_transport) and its rgb/camera_info, a colour camera registered to the depth
+//             camera (the same optical centre; TUM bags, depth_registered drivers). Each
+//             observation array takes the image of the nearest stamp within
+//             ~rgb_max_stamp_difference (ros/colour_image_buffer.h); its supporting points (the
+//             decimated subset the observations carry) take the colours of their pixels
+//             (frontend/support_colours.h), which the reconstruction keeps. A frame without a
+//             matching image is mapped uncoloured, never dropped.
 // Publishes   map (quadric_slam/QuadricMap in ~map_frame, latched: on keyframes, after a load or
 //             a reset; ids of landmarks merged into others in merged_ids / merged_into)
 //             markers (visualization_msgs/MarkerArray, latched, with the map)
 //             reconstruction (sensor_msgs/PointCloud2 x y z rgb label in ~map_frame, latched: every
-//             ~reconstruction_every_keyframes keyframes, on ~save_map and after ~load_map)
+//             ~reconstruction_every_keyframes keyframes, on ~save_map and after ~load_map; rgb =
+//             the pixel's colour with ~use_rgb, else the landmark's colour)
 //             path (nav_msgs/Path of T_map_camera per frame in ~map_frame, at most ~max_path_poses)
 //             tf ~map_frame -> ~odom_frame (T_map_odom, REP-105; when ~publish_tf)
 //             /diagnostics (landmarks per class, window, solve time, associations, frames
@@ -35,6 +44,7 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/TransformStamped.h>
+#include <image_transport/image_transport.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/exact_time.h>
 #include <message_filters/synchronizer.h>
@@ -60,11 +70,14 @@
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/SaveMap.h"
 #include "quadric_slam/eval/recent_durations.h"
+#include "quadric_slam/frontend/support_colours.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/mapping/tracking_recovery.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
+#include "quadric_slam/ros/colour_image_buffer.h"
 #include "quadric_slam/ros/conversions.h"
+#include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/drop_reporter.h"
 #include "quadric_slam/ros/frame_ids.h"
@@ -120,6 +133,7 @@ class MappingNodelet : public nodelet::Nodelet {
   ~MappingNodelet() override {
     // The synchroniser calls back into this object: disconnect it before the members go.
     sync_.reset();
+    rgb_sub_.shutdown();
   }
 
  private:
@@ -137,6 +151,8 @@ class MappingNodelet : public nodelet::Nodelet {
     int queue_size = 10;
     double diagnostic_period = 1.0;
     bool localization_only = false;
+    int rgb_buffer_size = 60;
+    double rgb_max_stamp_difference = 0.02;
     try {
       const RosParamReader reader(private_nh);
       readFrameParam(reader, "map_frame", map_frame_, log);
@@ -148,6 +164,14 @@ class MappingNodelet : public nodelet::Nodelet {
       readParam(reader, "map_file", map_file_, log);
       readParam(reader, "localization_only", localization_only, log);
       readParam(reader, "diagnostic_period", diagnostic_period, log);
+      readParam(reader, "use_rgb", use_rgb_, log);
+      readParam(reader, "rgb_buffer_size", rgb_buffer_size, log);
+      readParam(reader, "rgb_max_stamp_difference", rgb_max_stamp_difference, log);
+      rgb_max_stamp_difference_ = rgb_max_stamp_difference;
+      if (rgb_buffer_size < 1)
+        throw std::invalid_argument("rgb_buffer_size must be >= 1");
+      colour_images_ = std::make_unique<ColourImageBuffer>(
+          static_cast<std::size_t>(rgb_buffer_size), rgb_max_stamp_difference);
       readMappingParams(reader, mapper_params, reconstruction_params, log);
       readTrackingRecoveryParams(reader, recovery_params, log);
       if (map_frame_.empty() || odom_frame_.empty() || map_frame_ == odom_frame_)
@@ -220,6 +244,71 @@ class MappingNodelet : public nodelet::Nodelet {
     sync_ = std::make_unique<message_filters::Synchronizer<SyncPolicy>>(
         SyncPolicy(static_cast<std::uint32_t>(queue_size)), observations_sub_, odom_sub_);
     sync_->registerCallback(&MappingNodelet::onFrame, this);
+    if (use_rgb_) {
+      // rgb/image and rgb/camera_info, paired by image_transport (any transport it has a plugin
+      // for, e.g. compressed: ~image_transport).
+      image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
+      rgb_sub_ = image_transport_->subscribeCamera(
+          "rgb/image", static_cast<std::uint32_t>(rgb_buffer_size), &MappingNodelet::onRgb, this,
+          image_transport::TransportHints("raw", ros::TransportHints(), private_nh));
+    }
+  }
+
+  // A colour image and its camera_info into the buffer the observations look their colours up in.
+  void onRgb(const sensor_msgs::ImageConstPtr& image, const sensor_msgs::CameraInfoConstPtr& info) {
+    try {
+      {
+        std::lock_guard<std::mutex> lock(stats_mutex_);
+        ++stats_.rgb_images;
+      }
+      std::string problem = cameraInfoProblem(*info);
+      ColourImageBuffer::Entry entry;
+      if (problem.empty())
+        problem = colourImageToRgb(image, &entry.rgb);
+      if (problem.empty() && (info->width != image->width || info->height != image->height))
+        problem = "rgb/camera_info is for " + std::to_string(info->width) + "x" +
+                  std::to_string(info->height) + " images, the image is " +
+                  std::to_string(image->width) + "x" + std::to_string(image->height);
+      if (!problem.empty()) {
+        rgb_drops_.report(problem);
+        std::lock_guard<std::mutex> lock(stats_mutex_);
+        ++stats_.rgb_images_refused;
+        stats_.last_rgb_problem = problem;
+        return;
+      }
+      entry.stamp = image->header.stamp.toSec();
+      entry.intrinsics = intrinsicsFromCameraInfo(*info);
+      colour_images_->add(std::move(entry));
+    } catch (const std::exception& e) {
+      rgb_drops_.report(std::string("unexpected error: ") + e.what());
+    }
+  }
+
+  // The supporting points' colours from the colour image of the frame's stamp, if there is one.
+  void colourFrame(FrameMeasurements& frame, const ros::Time& stamp) {
+    ColourImageBuffer::Entry image;
+    bool coloured = colour_images_->nearest(stamp.toSec(), &image);
+    if (!coloured) {
+      double oldest = 0.0, newest = 0.0;
+      rgb_drops_.report(colour_images_->span(&oldest, &newest)
+                            ? (stamp.toSec() < oldest
+                                   ? "the observations are older than every buffered colour "
+                                     "image (raise ~rgb_buffer_size)"
+                                   : "no colour image within ~rgb_max_stamp_difference of "
+                                     "the observations")
+                            : "no colour image received on rgb/image yet");
+    }
+    colour_images_->dropBefore(stamp.toSec() - rgb_max_stamp_difference_);
+    if (coloured) {
+      try {
+        colourSupportPoints(frame, image.rgb->image, image.intrinsics);
+      } catch (const std::invalid_argument& e) {
+        rgb_drops_.report(e.what());
+        coloured = false;
+      }
+    }
+    std::lock_guard<std::mutex> lock(stats_mutex_);
+    ++(coloured ? stats_.frames_coloured : stats_.frames_without_rgb);
   }
 
   // --- Input ------------------------------------------------------------------------------------
@@ -319,6 +408,9 @@ class MappingNodelet : public nodelet::Nodelet {
     }
     if (bad > 0)
       observation_drops_.report(why);
+
+    if (use_rgb_)
+      colourFrame(frame, stamp);
 
     // 4. The mapper.
     const MapperFrameResult result = mapper_->process(frame, odometry);
@@ -444,11 +536,14 @@ class MappingNodelet : public nodelet::Nodelet {
     mapper_->loadLandmarks(base.map.landmarks, base.fixed, T_map_odom);
     reconstruction_->clear();
     std::map<int, std::vector<Eigen::Vector3f>> points;
-    for (const pcl::PointXYZL& p : base.map.reconstruction)
+    std::map<int, std::vector<std::uint32_t>> colours;  // alpha 0: the landmark's colour
+    for (const pcl::PointXYZRGBL& p : base.map.reconstruction) {
       points[static_cast<int>(p.label)].emplace_back(p.x, p.y, p.z);
+      colours[static_cast<int>(p.label)].push_back(p.rgba);
+    }
     for (const auto& [id, landmark_points] : points)
       reconstruction_->addPoints(id, mapper_->map().landmark(id).quadric_map,
-                                 Eigen::Isometry3d::Identity(), landmark_points);
+                                 Eigen::Isometry3d::Identity(), landmark_points, colours[id]);
   }
 
   // Replaces the map with the saved one at `path`; false (mapper untouched) with *message saying
@@ -614,6 +709,8 @@ class MappingNodelet : public nodelet::Nodelet {
     std::string observation_frame, camera_frame;  // of the latest frame (observations, odom child)
     std::string mode = "mapping";                 // or "localisation only"
     std::string loaded_from;                      // the loaded map file, if any
+    long rgb_images = 0, rgb_images_refused = 0, frames_coloured = 0, frames_without_rgb = 0;
+    std::string last_rgb_problem;
     // At the previous report.
     long reported_processed = 0, reported_dropped = 0, reported_observations_dropped = 0;
   };
@@ -706,6 +803,13 @@ class MappingNodelet : public nodelet::Nodelet {
     status.add("window final cost", s.window.final_cost);
     status.add("solve time (ms, last keyframe)", s.solve_ms);
     status.add("association time (ms, last frame)", s.association_ms);
+    if (use_rgb_) {
+      status.add("rgb images received", s.rgb_images);
+      status.add("rgb images refused", s.rgb_images_refused);
+      status.add("last rgb problem", s.last_rgb_problem);
+      status.add("frames coloured", s.frames_coloured);
+      status.add("frames without a matching rgb image", s.frames_without_rgb);
+    }
     addTimingValues(status, s.processing_times.summary());
   }
 
@@ -716,6 +820,8 @@ class MappingNodelet : public nodelet::Nodelet {
   int reconstruction_every_keyframes_ = 5;
   int max_path_poses_ = 10000;
   std::string map_file_;
+  bool use_rgb_ = false;
+  double rgb_max_stamp_difference_ = 0.02;  // s
 
   // State (mutex_): the core objects and what the outputs need.
   std::mutex mutex_;
@@ -736,6 +842,7 @@ class MappingNodelet : public nodelet::Nodelet {
   // Errors on rosout, throttled per reason (the counts go to stats_).
   DropReporter frame_drops_{"mapping: dropping frame", nullptr};
   DropReporter observation_drops_{"mapping: dropping observations", nullptr};
+  DropReporter rgb_drops_{"mapping: no colours from rgb/image", nullptr};
   Stats stats_;
 
   QuadricMapPublisher map_publisher_;
@@ -747,6 +854,9 @@ class MappingNodelet : public nodelet::Nodelet {
   message_filters::Subscriber<QuadricObservationArray> observations_sub_;
   message_filters::Subscriber<nav_msgs::Odometry> odom_sub_;
   std::unique_ptr<message_filters::Synchronizer<SyncPolicy>> sync_;
+  std::unique_ptr<ColourImageBuffer> colour_images_;
+  std::unique_ptr<image_transport::ImageTransport> image_transport_;
+  image_transport::CameraSubscriber rgb_sub_;
 };
 
 }  // namespace quadric_slam

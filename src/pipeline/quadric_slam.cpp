@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "quadric_slam/frontend/detection_measurement.h"
+#include "quadric_slam/frontend/support_colours.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/pipeline/segmenter_params.h"
 
@@ -96,6 +97,13 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
     segmentation_ = timer_.time("segmentation", [&] { return segmenter_.segment(cloud_); });
     out.measurements = toFrameMeasurements(segmentation_, frame.stamp, frame.frame_id);
     attachSupportPoints(out.measurements, segmentation_, cloud_, params_.max_support_points);
+    if (!frame.rgb.empty()) {
+      try {
+        colourSupportPoints(out.measurements, frame.rgb, k);
+      } catch (const std::invalid_argument& e) {
+        out.message = std::string("no colours: ") + e.what();  // the points stay uncoloured
+      }
+    }
   }
   // The segmentation's surfaces give the odometry a motion guess for large steps.
   out.odometry = timer_.time("odometry", [&] {
@@ -147,7 +155,7 @@ std::vector<LandmarkMerge> QuadricSlam::mergeDuplicateLandmarks() {
   return merges;
 }
 
-pcl::PointCloud<pcl::PointXYZL> QuadricSlam::reconstructionCloud() const {
+pcl::PointCloud<pcl::PointXYZRGBL> QuadricSlam::reconstructionCloud() const {
   std::map<int, QuadricModel> surfaces;
   for (const auto& [id, landmark] : mapper_.map().landmarks())
     surfaces[id] = landmark.quadric_map;

@@ -92,18 +92,23 @@ LoadedMap loadMapFiles(const std::string& map_path) {
   pcl::PCLPointCloud2 cloud;
   if (pcl::io::loadPCDFile(pcd_path, cloud) != 0)
     throw std::runtime_error("cannot read the reconstruction " + pcd_path);
-  bool has_label = false;
-  for (const pcl::PCLPointField& field : cloud.fields)
+  bool has_label = false, has_colour = false;
+  for (const pcl::PCLPointField& field : cloud.fields) {
     has_label = has_label || field.name == "label";
+    has_colour = has_colour || field.name == "rgb" || field.name == "rgba";
+  }
   if (!has_label)
     throw std::runtime_error(pcd_path + ": no 'label' field (the landmark id of each point)");
-  pcl::PointCloud<pcl::PointXYZL> points;
+  pcl::PointCloud<pcl::PointXYZRGBL> points;
   pcl::fromPCLPointCloud2(cloud, points);
+  if (!has_colour)
+    for (pcl::PointXYZRGBL& p : points)
+      p.rgba = 0;  // no colours: each landmark's own (PCL's default would be opaque black)
   loaded.reconstruction_path = pcd_path;
 
   // Extents: the box of each landmark's points in its quadric frame.
   std::set<int> has_points;
-  for (const pcl::PointXYZL& p : points) {
+  for (const pcl::PointXYZRGBL& p : points) {
     const auto it = index.find(static_cast<int>(p.label));
     const Eigen::Vector3d p_map(p.x, p.y, p.z);
     if (it == index.end() || !p_map.allFinite())

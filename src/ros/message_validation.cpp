@@ -128,6 +128,30 @@ std::string depthImageProblem(const sensor_msgs::Image& image) {
   return why.str();
 }
 
+std::string colourImageProblem(const sensor_msgs::Image& image) {
+  const std::size_t pixel_bytes = image.encoding == "rgb8" || image.encoding == "bgr8" ? 3
+                                  : image.encoding == "mono8"                          ? 1
+                                                                                       : 0;
+  if (pixel_bytes == 0)
+    return "unsupported colour encoding '" + image.encoding + "' (expected rgb8, bgr8 or mono8)";
+  std::string problem = gridSizeProblem("colour image", image.width, image.height, true);
+  if (!problem.empty())
+    return problem;
+  std::ostringstream why;
+  const std::uint64_t row_bytes = static_cast<std::uint64_t>(image.width) * pixel_bytes;
+  const std::uint64_t data_bytes = static_cast<std::uint64_t>(image.step) * image.height;
+  if (image.step < row_bytes) {
+    why << image.encoding << " colour image step " << image.step
+        << " is smaller than width x pixel size (" << image.width << " x " << pixel_bytes << " = "
+        << row_bytes << ")";
+  } else if (image.data.size() != data_bytes) {
+    why << image.encoding << " colour image data has " << image.data.size()
+        << " bytes, but step x height is " << image.step << " x " << image.height << " = "
+        << data_bytes;
+  }
+  return why.str();
+}
+
 std::string cameraInfoProblem(const sensor_msgs::CameraInfo& info) {
   const std::string problem = gridSizeProblem("camera_info", info.width, info.height, true);
   if (!problem.empty())

@@ -12,7 +12,7 @@
 
 namespace quadric_slam {
 
-sensor_msgs::PointCloud2 reconstructionCloudMsg(const pcl::PointCloud<pcl::PointXYZL>& points,
+sensor_msgs::PointCloud2 reconstructionCloudMsg(const pcl::PointCloud<pcl::PointXYZRGBL>& points,
                                                 const std_msgs::Header& header) {
   sensor_msgs::PointCloud2 msg;
   msg.header = header;
@@ -28,7 +28,19 @@ sensor_msgs::PointCloud2 reconstructionCloudMsg(const pcl::PointCloud<pcl::Point
   sensor_msgs::PointCloud2Iterator<float> x(msg, "x"), rgb(msg, "rgb");
   sensor_msgs::PointCloud2Iterator<std::uint32_t> label(msg, "label");
   std::map<std::uint32_t, float> packed_colours;  // one colour computation per landmark
-  for (const pcl::PointXYZL& p : points) {
+  for (const pcl::PointXYZRGBL& p : points) {
+    x[0] = p.x;
+    x[1] = p.y;
+    x[2] = p.z;
+    *label = p.label;
+    if ((p.rgba >> 24) != 0) {  // a colour from the RGB image
+      const std::uint32_t rgba_bits = p.rgba | 0xFF000000u;
+      std::memcpy(&*rgb, &rgba_bits, sizeof(float));
+      ++x;
+      ++rgb;
+      ++label;
+      continue;
+    }
     auto colour = packed_colours.find(p.label);
     if (colour == packed_colours.end()) {
       const std_msgs::ColorRGBA c = landmarkColour(static_cast<int>(p.label), 1.0);
@@ -40,11 +52,7 @@ sensor_msgs::PointCloud2 reconstructionCloudMsg(const pcl::PointCloud<pcl::Point
       std::memcpy(&packed, &rgb_bits, sizeof(packed));
       colour = packed_colours.emplace(p.label, packed).first;
     }
-    x[0] = p.x;
-    x[1] = p.y;
-    x[2] = p.z;
     *rgb = colour->second;
-    *label = p.label;
     ++x;
     ++rgb;
     ++label;

@@ -7,7 +7,9 @@
 //   DIR/trajectory_odom.txt  the odometry, camera optical frame in the odom frame
 //   DIR/timing.json          per-stage median/p95/max
 //   DIR/map.yaml             the landmarks (map schema), unless --odometry-only
-//   DIR/reconstruction.pcd   landmark points projected onto their surfaces (label = landmark id)
+//   DIR/reconstruction.pcd   landmark points projected onto their surfaces (label = landmark id;
+//                            rgba = the pixel's colour when the input has RGB, alpha 255, else
+//                            the landmark's colour, alpha 0: ros/reconstruction_cloud.h)
 //   DIR/resources.csv        every --sample-every frames: resident memory, frame time, landmarks
 // With --gt prints the ATE and RPE of the odometry (ate_rmse_m ...) and of SLAM (map_ate_rmse_m
 // ...). INPUT may also be a scene file (config/scenes/*.yaml): its frames are rendered as they are
@@ -15,9 +17,10 @@
 // goes to DIR/groundtruth.txt and is used when --gt is not given.
 //
 //   run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR] [--max-frames N]
-//           [--intrinsics fx,fy,cx,cy] [--quiet] [--sample-every N]
+//           [--intrinsics fx,fy,cx,cy] [--quiet] [--sample-every N] [--no-rgb]
 //           [--seconds S] [--rate HZ] [--seed N]   (scene INPUT only)
 #include <pcl/io/pcd_io.h>
+#include <pcl_conversions/pcl_conversions.h>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -37,6 +40,7 @@
 #include "quadric_slam/io/trajectory_io.h"
 #include "quadric_slam/io/tum_folder_reader.h"
 #include "quadric_slam/pipeline/quadric_slam.h"
+#include "quadric_slam/ros/reconstruction_cloud.h"
 #include "quadric_slam/ros/tum_bag_reader.h"
 #include "quadric_slam/sim/scene_yaml.h"
 #include "quadric_slam/sim/synthetic_frame_source.h"
@@ -51,6 +55,7 @@ struct Options {
   std::string config_dir = QUADRIC_SLAM_CONFIG_DIR;
   bool odometry_only = false;
   bool quiet = false;
+  bool rgb = true;  // read RGB when the input has it (it colours the reconstruction only)
   long max_frames = -1;
   long sample_every = 30;
   qs::CameraIntrinsics intrinsics;             // fx = 0: from the input
@@ -67,11 +72,13 @@ int usage(const std::string& problem) {
       << "run_bag: " << problem << "\n"
       << "usage: run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR]\n"
       << "               [--max-frames N] [--intrinsics fx,fy,cx,cy] [--quiet]\n"
-      << "               [--sample-every N] [--seconds S] [--rate HZ] [--seed N]\n"
+      << "               [--sample-every N] [--no-rgb] [--seconds S] [--rate HZ] [--seed N]\n"
       << "  INPUT: a TUM rosbag (.bag), a TUM folder (rgb.txt, depth.txt, depth/), or a scene\n"
       << "         file (config/scenes/*.yaml) rendered frame by frame: --seconds (default 60),\n"
       << "         --rate (default: the scene's), --seed (default 1) apply to it\n"
-      << "  --sample-every N: a line of DIR/resources.csv every N frames (default 30)\n";
+      << "  --sample-every N: a line of DIR/resources.csv every N frames (default 30)\n"
+      << "  --no-rgb: depth only (by default RGB, when the input has it, colours the\n"
+      << "            reconstruction; frames without an RGB partner run uncoloured)\n";
   return 2;
 }
 
@@ -94,6 +101,8 @@ bool parseOptions(int argc, char** argv, Options& o, std::string& problem) {
         o.max_frames = std::stol(value());
       } else if (arg == "--odometry-only") {
         o.odometry_only = true;
+      } else if (arg == "--no-rgb") {
+        o.rgb = false;
       } else if (arg == "--quiet") {
         o.quiet = true;
       } else if (arg == "--sample-every") {
@@ -134,19 +143,25 @@ std::unique_ptr<qs::FrameSource> openInput(const Options& o) {
     if (o.intrinsics.fx > 0)
       throw std::invalid_argument("--intrinsics does not apply to a scene (set its camera)");
     qs::SyntheticFrameSource::Params params = o.synthetic;
-    params.rgb = false;  // depth is all the pipeline uses
+    params.rgb = o.rgb;  // colours the reconstruction only
     return std::make_unique<qs::SyntheticFrameSource>(scene, params);
   }
   if (fs::is_directory(o.input)) {
     qs::TumFolderReader::Params params;
-    params.load_rgb = false;  // depth is all the pipeline uses
+    // RGB (registered to depth, paired by stamp: io/stamp_association.h) colours the
+    // reconstruction only; a depth frame without an RGB partner runs uncoloured, so the frames and
+    // the map are those of a depth-only run.
+    params.load_rgb = o.rgb && fs::is_regular_file(fs::path(o.input) / "rgb.txt");
+    params.keep_frames_without_rgb = true;
     if (o.intrinsics.fx > 0)
       params.intrinsics = o.intrinsics;
     return std::make_unique<qs::TumFolderReader>(o.input, params);
   }
   if (fs::is_regular_file(o.input)) {
     qs::TumBagReader::Params params;
-    params.rgb_topic.clear();  // depth only
+    if (!o.rgb)
+      params.rgb_topic.clear();             // depth only
+    params.keep_frames_without_rgb = true;  // as for a folder: the same frames with or without RGB
     if (o.intrinsics.fx > 0)
       params.intrinsics = o.intrinsics;
     return std::make_unique<qs::TumBagReader>(o.input, params);
@@ -324,7 +339,11 @@ int main(int argc, char** argv) {
       std::map<std::string, int> per_class;
       for (const qs::QuadricLandmark& landmark : landmarks)
         ++per_class[qs::toString(landmark.quadric_map.quadricClass())];
-      const pcl::PointCloud<pcl::PointXYZL> points = slam.reconstructionCloud();
+      // The same points and colours as the mapping nodelet's reconstruction topic.
+      std_msgs::Header header;
+      header.frame_id = "map";
+      pcl::PointCloud<pcl::PointXYZRGBL> points;
+      pcl::fromROSMsg(qs::reconstructionCloudMsg(slam.reconstructionCloud(), header), points);
       if (!points.empty())
         pcl::io::savePCDFileBinary(o.out_dir + "/reconstruction.pcd", points);
       std::printf("map landmarks %zu:", landmarks.size());

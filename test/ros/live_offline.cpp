@@ -97,7 +97,8 @@ struct SlamRun {
 SlamRun runOffline(const std::string& bag_path, const fs::path& out_dir) {
   const fs::path run_bag = fs::canonical("/proc/self/exe").parent_path() / "run_bag";
   const std::string command = run_bag.string() + " " + bag_path + " --out " + out_dir.string() +
-                              " --config " + QUADRIC_SLAM_SOURCE_DIR + "/config --quiet > " +
+                              " --config " + QUADRIC_SLAM_SOURCE_DIR +
+                              "/config --quiet --no-rgb > " +
                               (out_dir.parent_path() / "run_bag.log").string() + " 2>&1";
   SlamRun run;
   if (std::system(command.c_str()) != 0) {

@@ -6,7 +6,8 @@
 // per voxel of that frame, so memory is bounded by the observed area rather than by the number of
 // frames, and a landmark whose estimate moves carries its points with it: cloud() places every
 // point with the current T_map_quadric and projects it onto the current surface
-// (geometry/surface_distance.h).
+// (geometry/surface_distance.h). Each point may carry the RGB colour of the pixel it came from
+// (frontend/support_colours.h), packed 0xAARRGGBB, alpha 0 = uncoloured.
 #pragma once
 
 #include <pcl/point_cloud.h>
@@ -40,9 +41,11 @@ class QuadricReconstruction {
   // landmark's current estimate in the map frame. Points that are not finite, or farther than
   // max_surface_distance from the surface (exact distance for the classes of revolution and planes,
   // first-order for general quadrics), are skipped, as are points in an occupied voxel. Returns how
-  // many points were stored.
+  // many points were stored. colours_rgba: one packed colour per point (alpha 0 = none), or empty
+  // for uncoloured points; a voxel keeps the colour of the point that occupied it first.
   int addPoints(int id, const QuadricModel& landmark_map, const Eigen::Isometry3d& T_map_camera,
-                const std::vector<Eigen::Vector3f>& points_camera);
+                const std::vector<Eigen::Vector3f>& points_camera,
+                const std::vector<std::uint32_t>& colours_rgba = {});
 
   // Landmark `from` was merged into `to` (mapping/landmark_merger.h): its points join `to`'s,
   // re-expressed with T_to_from (from's quadric frame in to's), one per voxel of to's frame and
@@ -55,15 +58,19 @@ class QuadricReconstruction {
   std::size_t size(int id) const;  // points stored for one landmark (0 when unknown)
 
   // The stored points of every landmark in `landmarks_map` (id -> current estimate, map frame),
-  // placed with that estimate and projected onto its surface, labelled with the landmark id.
+  // placed with that estimate and projected onto its surface, labelled with the landmark id, rgba
+  // = the point's colour (alpha 0: uncoloured, the caller colours it per landmark).
   // Landmarks without points, and points whose projection fails (a general quadric far from
   // convergence), are left out.
-  pcl::PointCloud<pcl::PointXYZL> cloud(const std::map<int, QuadricModel>& landmarks_map) const;
+  pcl::PointCloud<pcl::PointXYZRGBL> cloud(const std::map<int, QuadricModel>& landmarks_map) const;
 
  private:
   struct LandmarkPoints {
     std::unordered_set<std::uint64_t> voxels;  // packed integer voxel coordinates
     std::vector<Eigen::Vector3f> points_quadric;
+    // rgba[i] is the colour of points_quadric[i]; it may be shorter (points beyond its end are
+    // uncoloured), so code that appends points without colours keeps them aligned.
+    std::vector<std::uint32_t> rgba;
   };
   std::uint64_t voxelKey(const Eigen::Vector3d& p_quadric) const;
 

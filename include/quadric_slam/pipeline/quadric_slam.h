@@ -12,9 +12,10 @@
 //   5. odometry (odometry/odometry_tracker.h);
 //   6. mapping (mapping/quadric_mapper.h) once odometry is initialised, and on keyframes the
 //      supporting points of the landmark observations into the reconstruction (after moving the
-//      points of landmarks the mapper merged). A frame whose odometry is lost reaches no mapper;
-//      after a loss the mapper localises only until the surfaces anchor the pose in the map again
-//      (mapping/tracking_recovery.h).
+//      points of landmarks the mapper merged), coloured from frame.rgb when the frame has one
+//      (frontend/support_colours.h: RGB registered to depth). A frame whose odometry is lost
+//      reaches no mapper; after a loss the mapper localises only until the surfaces anchor the
+//      pose in the map again (mapping/tracking_recovery.h).
 // Every stage is timed under its name (timer()): normals, segmentation, odometry, mapping,
 // reconstruction.
 #pragma once
@@ -96,8 +97,9 @@ class QuadricSlam {
   const OdometryTracker& odometry() const { return odometry_; }
   const QuadricReconstruction& reconstruction() const { return reconstruction_; }
   const TrackingRecovery& recovery() const { return recovery_; }
-  // The landmarks' points on their current surfaces, label = landmark id.
-  pcl::PointCloud<pcl::PointXYZL> reconstructionCloud() const;
+  // The landmarks' points on their current surfaces, label = landmark id, rgba = the colour of the
+  // pixel the point came from when the frames had RGB (alpha 0: uncoloured).
+  pcl::PointCloud<pcl::PointXYZRGBL> reconstructionCloud() const;
   // The latest frame's organized cloud with normals, and its segmentation (labels per point).
   const pcl::PointCloud<pcl::PointNormal>& cloud() const { return cloud_; }
   const Segmentation& segmentation() const { return segmentation_; }

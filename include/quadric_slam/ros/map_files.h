@@ -31,8 +31,9 @@ struct LoadedMap {
   std::string frame_id;
   std::vector<QuadricLandmark> landmarks;
   std::string reconstruction_path;  // empty when there was no PCD beside the YAML
-  // The PCD's points (map frame, label = landmark id); points of unknown landmarks are left out.
-  pcl::PointCloud<pcl::PointXYZL> reconstruction;
+  // The PCD's points (map frame, label = landmark id, rgba as ros/reconstruction_cloud.h wrote
+  // it: alpha != 0 a colour from the RGB image); points of unknown landmarks are left out.
+  pcl::PointCloud<pcl::PointXYZRGBL> reconstruction;
 };
 
 // Reads the map YAML and, when present, the PCD beside it; each landmark's extent is the box of its

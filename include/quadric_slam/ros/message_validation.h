@@ -51,6 +51,11 @@ std::string pointCloudProblem(const sensor_msgs::PointCloud2& cloud, const Cloud
 // step >= width * pixel size, data exactly step * height bytes.
 std::string depthImageProblem(const sensor_msgs::Image& image);
 
+// Empty when the image is a colour image the mapping nodelet reads (rgb8, bgr8 or mono8; the
+// reconstruction's colours), at least kMinGridSide x kMinGridSide and at most kMaxMessagePixels,
+// step >= width * pixel size, data exactly step * height bytes.
+std::string colourImageProblem(const sensor_msgs::Image& image);
+
 // Empty when camera_info describes a usable camera: a size like an image's (see depthImageProblem)
 // and positive finite focal lengths, finite principal point.
 std::string cameraInfoProblem(const sensor_msgs::CameraInfo& info);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,10 @@ struct QuadricMeasurement {
   // A bounded subset of the supporting points (camera frame, m) for the reconstruction; may be
   // empty (frontend/detection_measurement.h: attachSupportPoints).
   std::vector<Eigen::Vector3f> support_points;
+  // The RGB colour of each support point (frontend/support_colours.h), packed 0xAARRGGBB with
+  // alpha 255 = sampled from the RGB image, 0 = no colour (outside the image); either empty (no RGB
+  // image) or one per support point.
+  std::vector<std::uint32_t> support_colours;
 };
 
 // All observations of one frame.

@@ -224,4 +224,51 @@ TEST(QuadricReconstruction, MovedLandmarkPointsKeepTheirPlaceInTheMap) {
   EXPECT_EQ(reconstruction.size(3), 0u);
   reconstruction.moveLandmark(42, 1, Eigen::Isometry3d::Identity());
   EXPECT_EQ(reconstruction.size(1), 400u);
+
+// Colours travel with their points: each stored point keeps the colour of the point that filled its
+// voxel, a landmark added without colours has uncoloured points (alpha 0: its own colour is the
+// caller's), and a colour list that does not match the points is refused.
+TEST(QuadricReconstruction, PointsKeepTheirColoursAndUncolouredLandmarksStayUncoloured) {
+  qs::CylinderShape shape;
+  shape.point = Eigen::Vector3d(1.0, 0.5, 0.3);
+  shape.axis = Eigen::Vector3d(0.0, 0.0, 1.0);
+  shape.radius = 0.2;
+  const qs::QuadricModel cylinder = qs::quadricFromShape(shape);
+  const Eigen::Isometry3d T_map_camera = cameraPose();
+  const auto points = cylinderPointsInCamera(shape, T_map_camera, 0.0, 4000, 2);
+  // The colour pattern: red grows with the height along the axis, blue is fixed.
+  std::vector<std::uint32_t> colours;
+  for (const Eigen::Vector3f& p : points) {
+    const double height = (T_map_camera * p.cast<double>()).z() - shape.point.z();  // [-0.2, 0.2]
+    const auto red = static_cast<std::uint32_t>(std::lround((height + 0.2) / 0.4 * 255.0));
+    colours.push_back(0xFF000000u | red << 16 | 0x40u);
+  }
+  qs::QuadricReconstruction reconstruction;
+  EXPECT_THROW(reconstruction.addPoints(1, cylinder, T_map_camera, points, {0xFF000000u}),
+               std::invalid_argument);
+  const int added = reconstruction.addPoints(1, cylinder, T_map_camera, points, colours);
+  ASSERT_GT(added, 500);
+  qs::CylinderShape other = shape;
+  other.point.x() += 2.0;
+  const qs::QuadricModel uncoloured = qs::quadricFromShape(other);
+  ASSERT_GT(reconstruction.addPoints(2, uncoloured, T_map_camera,
+                                     cylinderPointsInCamera(other, T_map_camera, 0.0, 1000, 3)),
+            100);
+
+  int coloured_points = 0, plain_points = 0;
+  for (const auto& p : reconstruction.cloud({{1, cylinder}, {2, uncoloured}})) {
+    if (p.label == 2u) {
+      EXPECT_EQ(p.rgba, 0u);
+      ++plain_points;
+      continue;
+    }
+    ++coloured_points;
+    EXPECT_EQ(p.rgba >> 24, 0xFFu);
+    EXPECT_EQ(p.rgba & 0xFFu, 0x40u);
+    // Within a voxel (1 cm of 40 cm height: 255 / 40 per cm) of the pattern at the stored point.
+    const double red_expected = (p.z - shape.point.z() + 0.2) / 0.4 * 255.0;
+    EXPECT_NEAR(static_cast<double>((p.rgba >> 16) & 0xFFu), red_expected, 0.5 + 255.0 / 40.0);
+  }
+  EXPECT_EQ(coloured_points, added);
+  EXPECT_GT(plain_points, 100);
 }

@@ -61,15 +61,17 @@ std::vector<qs::QuadricLandmark> everyClass() {
 }
 
 // Points on each landmark's surface (projected from a small grid around its origin), label = id.
-pcl::PointCloud<pcl::PointXYZL> surfacePoints(const std::vector<qs::QuadricLandmark>& landmarks) {
-  pcl::PointCloud<pcl::PointXYZL> cloud;
+pcl::PointCloud<pcl::PointXYZRGBL> surfacePoints(
+    const std::vector<qs::QuadricLandmark>& landmarks) {
+  pcl::PointCloud<pcl::PointXYZRGBL> cloud;
   const qs::SurfaceProjector projector;
   for (const qs::QuadricLandmark& l : landmarks) {
     for (int i = -2; i <= 2; ++i)
       for (int j = -2; j <= 2; ++j) {
         const Eigen::Vector3d near_q(0.05 * i, 0.05 * j, 0.1 + 0.02 * (i + j));
         const Eigen::Vector3d p = projector.project(l.quadric_map, l.quadric_map.pose() * near_q);
-        pcl::PointXYZL point;
+        pcl::PointXYZRGBL point;
+        point.rgba = 0;  // uncoloured: the landmark's colour
         point.x = static_cast<float>(p.x());
         point.y = static_cast<float>(p.y());
         point.z = static_cast<float>(p.z());
@@ -98,7 +100,7 @@ TEST_F(MapFilesTest, ReconstructionPathBesideTheMap) {
 
 TEST_F(MapFilesTest, SaveAndLoadGiveTheSameLandmarksWithExtentsFromThePoints) {
   const std::vector<qs::QuadricLandmark> landmarks = everyClass();
-  const pcl::PointCloud<pcl::PointXYZL> points = surfacePoints(landmarks);
+  const pcl::PointCloud<pcl::PointXYZRGBL> points = surfacePoints(landmarks);
   std_msgs::Header header;
   header.frame_id = "map";
   const std::string path = (dir_ / "maps" / "desk.yaml").string();  // the directory is created
@@ -122,7 +124,7 @@ TEST_F(MapFilesTest, SaveAndLoadGiveTheSameLandmarksWithExtentsFromThePoints) {
     EXPECT_EQ(b.covariance.size(), 0) << "covariances are not saved";
     // The extent is the box of the landmark's points in its quadric frame.
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
-    for (const pcl::PointXYZL& p : points) {
+    for (const pcl::PointXYZRGBL& p : points) {
       if (static_cast<int>(p.label) != a.id)
         continue;
       const Eigen::Vector3d q = a.quadric_map.pose().inverse() * Eigen::Vector3d(p.x, p.y, p.z);
@@ -253,9 +255,10 @@ TEST_F(MapFilesTest, FuzzedMapFilesAreRefusedOrLoadValidLandmarks) {
 }
 
 TEST(ReconstructionCloud, FieldsAndLandmarkColours) {
-  pcl::PointCloud<pcl::PointXYZL> points;
+  pcl::PointCloud<pcl::PointXYZRGBL> points;
   for (std::uint32_t label : {3u, 3u, 7u}) {
-    pcl::PointXYZL p;
+    pcl::PointXYZRGBL p;
+    p.rgba = 0;
     p.x = 0.1f * label;
     p.y = 0.2f;
     p.z = 1.5f;
@@ -290,6 +293,32 @@ TEST(ReconstructionCloud, FieldsAndLandmarkColours) {
     EXPECT_NEAR((bits & 0xff) / 255.0, c.b, 0.003);
   }
   EXPECT_EQ(qs::reconstructionCloudMsg({}, header).width, 0u);
+}
+
+// A point with a colour from the RGB image keeps it (alpha 255), beside an uncoloured point of the
+// same landmark drawn in the landmark's colour (alpha 0); both survive a save and a load.
+TEST_F(MapFilesTest, RgbColoursSurviveTheMessageAndTheFiles) {
+  const std::vector<qs::QuadricLandmark> landmarks = everyClass();
+  pcl::PointCloud<pcl::PointXYZRGBL> points = surfacePoints(landmarks);
+  ASSERT_GE(points.size(), 2u);
+  points[0].rgba = 0xFF123456u;  // coloured; points[1] stays uncoloured
+  ASSERT_EQ(points[1].rgba, 0u);
+  std_msgs::Header header;
+  header.frame_id = "map";
+  const sensor_msgs::PointCloud2 msg = qs::reconstructionCloudMsg(points, header);
+  sensor_msgs::PointCloud2ConstIterator<std::uint32_t> rgb(msg, "rgb");
+  EXPECT_EQ(rgb[0], 0xFF123456u);
+  const std_msgs::ColorRGBA c = qs::landmarkColour(static_cast<int>(points[1].label), 1.0);
+  const std::uint32_t landmark_bits = (*(rgb + 1));
+  EXPECT_EQ(landmark_bits >> 24, 0u);
+  EXPECT_NEAR(((landmark_bits >> 16) & 0xff) / 255.0, c.r, 0.003);
+
+  const std::string path = (dir_ / "rgb.yaml").string();
+  qs::saveMapFiles(path, landmarks, "map", msg);
+  const qs::LoadedMap loaded = qs::loadMapFiles(path);
+  ASSERT_EQ(loaded.reconstruction.size(), points.size());
+  EXPECT_EQ(loaded.reconstruction[0].rgba, 0xFF123456u);
+  EXPECT_EQ(loaded.reconstruction[1].rgba >> 24, 0u);
 }
 
 }  // namespace

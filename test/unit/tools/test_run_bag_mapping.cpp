@@ -12,6 +12,11 @@
 #include <filesystem>
 #include <string>
 
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
+
+#include <algorithm>
+
 #include "quadric_slam/io/map_yaml.h"
 
 namespace fs = std::filesystem;
@@ -81,12 +86,12 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
   for (const auto& quadric : map.quadrics)
     EXPECT_GE(quadric.observations, 5) << "landmark " << quadric.id << " entered early";
 
-  const std::string scored = run("evaluate",
-                                 "--gt " + (dir / "sequence/groundtruth.txt").string() + " --est " +
-                                     (dir / "out/trajectory.txt").string() + " --map " +
-                                     (dir / "out/map.yaml").string() + " --quadrics-gt " +
-                                     (dir / "sequence/quadrics_gt.yaml").string(),
-                                 &code);
+  const std::string scored =
+      run("evaluate",
+          "--gt " + (dir / "sequence/groundtruth.txt").string() + " --est " +
+              (dir / "out/trajectory.txt").string() + " --map " + (dir / "out/map.yaml").string() +
+              " --quadrics-gt " + (dir / "sequence/quadrics_gt.yaml").string(),
+          &code);
   ASSERT_EQ(code, 0) << scored;
   const std::size_t summary = scored.find("map_summary ");
   ASSERT_NE(summary, std::string::npos) << scored;
@@ -95,5 +100,32 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
   EXPECT_GE(valueAfter(line, "matched"), 6);
   EXPECT_EQ(valueAfter(line, "duplicates"), 0);
   EXPECT_EQ(valueAfter(line, "unmatched_estimates"), 0);
+
+  // The sequence has RGB (registered, rgb.txt): the reconstruction's points carry the colours of
+  // their pixels (alpha 255), which are the rendered surfaces' shades, not the landmark colours.
+  // Without RGB (--no-rgb) the same frames give the same map, every point in its landmark's colour.
+  const auto colouredShare = [](const fs::path& pcd, std::size_t* points) {
+    pcl::PointCloud<pcl::PointXYZRGBL> cloud;
+    if (pcl::io::loadPCDFile(pcd.string(), cloud) != 0)
+      return -1.0;
+    std::size_t coloured = 0;
+    for (const auto& p : cloud)
+      coloured += (p.rgba >> 24) == 0xFFu;
+    *points = cloud.size();
+    return static_cast<double>(coloured) / std::max<std::size_t>(cloud.size(), 1);
+  };
+  std::size_t points_rgb = 0, points_depth = 0;
+  EXPECT_GT(colouredShare(dir / "out/reconstruction.pcd", &points_rgb), 0.95);
+  const std::string depth_only =
+      run("run_bag",
+          (dir / "sequence").string() + " --out " + (dir / "out_depth").string() + " --gt " +
+              (dir / "sequence/groundtruth.txt").string() + " --quiet --no-rgb",
+          &code);
+  ASSERT_EQ(code, 0) << depth_only;
+  EXPECT_EQ(colouredShare(dir / "out_depth/reconstruction.pcd", &points_depth), 0.0);
+  EXPECT_EQ(points_depth, points_rgb);
+  EXPECT_EQ(valueAfter(depth_only, "map_ate_rmse_m"), map_ate);
+  EXPECT_EQ(quadric_slam::readMapYaml((dir / "out_depth/map.yaml").string()).quadrics.size(),
+            map.quadrics.size());
   fs::remove_all(dir);
 }
