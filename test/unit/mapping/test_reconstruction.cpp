@@ -224,6 +224,41 @@ TEST(QuadricReconstruction, MovedLandmarkPointsKeepTheirPlaceInTheMap) {
   EXPECT_EQ(reconstruction.size(3), 0u);
   reconstruction.moveLandmark(42, 1, Eigen::Isometry3d::Identity());
   EXPECT_EQ(reconstruction.size(1), 400u);
+}
+
+// A merged landmark's points keep their colours on the survivor; the survivor's own uncoloured
+// points stay uncoloured.
+TEST(QuadricReconstruction, MovedPointsKeepTheirColours) {
+  const Eigen::Isometry3d T_map_camera = cameraPose();
+  qs::PlaneShape shape;
+  shape.normal = Eigen::Vector3d::UnitZ();
+  const qs::QuadricModel floor = qs::quadricFromShape(shape);
+  std::vector<Eigen::Vector3f> points_a, points_b;
+  for (int i = 0; i < 10; ++i) {
+    points_a.push_back(
+        (T_map_camera.inverse() * Eigen::Vector3d(0.005 + 0.05 * i, 0.005, 0.0)).cast<float>());
+    points_b.push_back(
+        (T_map_camera.inverse() * Eigen::Vector3d(0.005 + 0.05 * i, 0.505, 0.0)).cast<float>());
+  }
+  qs::QuadricReconstruction reconstruction;
+  ASSERT_EQ(reconstruction.addPoints(1, floor, T_map_camera, points_a), 10);
+  ASSERT_EQ(reconstruction.addPoints(2, floor, T_map_camera, points_b,
+                                     std::vector<std::uint32_t>(10, 0xFF102030u)),
+            10);
+  reconstruction.moveLandmark(2, 1, Eigen::Isometry3d::Identity());
+  int coloured = 0, plain = 0;
+  for (const auto& p : reconstruction.cloud({{1, floor}})) {
+    if (p.y > 0.25) {
+      EXPECT_EQ(p.rgba, 0xFF102030u);
+      ++coloured;
+    } else {
+      EXPECT_EQ(p.rgba >> 24, 0u);
+      ++plain;
+    }
+  }
+  EXPECT_EQ(coloured, 10);
+  EXPECT_EQ(plain, 10);
+}
 
 // Colours travel with their points: each stored point keeps the colour of the point that filled its
 // voxel, a landmark added without colours has uncoloured points (alpha 0: its own colour is the

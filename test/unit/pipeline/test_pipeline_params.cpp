@@ -99,11 +99,13 @@ TEST(PipelineParams, MappingYamlKeysAreAllRead) {
   double period = 1.0;
   for (const char* key : {"map_frame", "odom_frame", "map_file"})
     qs::readParam(reader, key, text, log);
-  for (const char* key : {"publish_tf", "localization_only"})
+  for (const char* key : {"publish_tf", "localization_only", "use_rgb"})
     qs::readParam(reader, key, flag, log);
-  for (const char* key : {"queue_size", "reconstruction_every_keyframes", "max_path_poses"})
+  for (const char* key :
+       {"queue_size", "reconstruction_every_keyframes", "max_path_poses", "rgb_buffer_size"})
     qs::readParam(reader, key, count, log);
   qs::readParam(reader, "diagnostic_period", period, log);
+  qs::readParam(reader, "rgb_max_stamp_difference", period, log);
   for (const auto& entry : file) {
     const std::string key = entry.first.as<std::string>();
     EXPECT_NE(log.str().find("\n  " + key + ": "), std::string::npos)

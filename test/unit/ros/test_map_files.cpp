@@ -233,7 +233,7 @@ TEST_F(MapFilesTest, FuzzedMapFilesAreRefusedOrLoadValidLandmarks) {
         EXPECT_TRUE(l.quadric_map.scale().allFinite() && (l.quadric_map.scale().array() > 0).all())
             << "case " << k << ": scale " << l.quadric_map.scale().transpose();
       }
-      for (const pcl::PointXYZL& p : map.reconstruction) {
+      for (const auto& p : map.reconstruction) {
         EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) << "case " << k;
         EXPECT_TRUE(ids.count(static_cast<int>(p.label))) << "case " << k;
       }
