@@ -102,6 +102,32 @@ std::string pointCloudProblem(const sensor_msgs::PointCloud2& cloud, const Cloud
   return why.str();
 }
 
+namespace {
+
+// The grid size, step and data length of an image whose pixels take pixel_bytes each; "" when
+// they fit. kind names the image in the message ("depth image").
+std::string imageLayoutProblem(const sensor_msgs::Image& image, const std::string& kind,
+                               std::size_t pixel_bytes) {
+  std::string problem = gridSizeProblem(kind, image.width, image.height, true);
+  if (!problem.empty())
+    return problem;
+  std::ostringstream why;
+  const std::uint64_t row_bytes = static_cast<std::uint64_t>(image.width) * pixel_bytes;
+  const std::uint64_t data_bytes = static_cast<std::uint64_t>(image.step) * image.height;
+  if (image.step < row_bytes) {
+    why << image.encoding << " " << kind << " step " << image.step
+        << " is smaller than width x pixel size (" << image.width << " x " << pixel_bytes << " = "
+        << row_bytes << ")";
+  } else if (image.data.size() != data_bytes) {
+    why << image.encoding << " " << kind << " data has " << image.data.size()
+        << " bytes, but step x height is " << image.step << " x " << image.height << " = "
+        << data_bytes;
+  }
+  return why.str();
+}
+
+}  // namespace
+
 std::string depthImageProblem(const sensor_msgs::Image& image) {
   const std::size_t pixel_bytes = depthPixelBytes(image.encoding);
   if (pixel_bytes == 0) {
@@ -110,22 +136,7 @@ std::string depthImageProblem(const sensor_msgs::Image& image) {
   }
   if (image.is_bigendian)
     return "big-endian depth image (is_bigendian true) is not supported";
-  std::string problem = gridSizeProblem("depth image", image.width, image.height, true);
-  if (!problem.empty())
-    return problem;
-  std::ostringstream why;
-  const std::uint64_t row_bytes = static_cast<std::uint64_t>(image.width) * pixel_bytes;
-  const std::uint64_t data_bytes = static_cast<std::uint64_t>(image.step) * image.height;
-  if (image.step < row_bytes) {
-    why << image.encoding << " depth image step " << image.step
-        << " is smaller than width x pixel size (" << image.width << " x " << pixel_bytes << " = "
-        << row_bytes << ")";
-  } else if (image.data.size() != data_bytes) {
-    why << image.encoding << " depth image data has " << image.data.size()
-        << " bytes, but step x height is " << image.step << " x " << image.height << " = "
-        << data_bytes;
-  }
-  return why.str();
+  return imageLayoutProblem(image, "depth image", pixel_bytes);
 }
 
 std::string colourImageProblem(const sensor_msgs::Image& image) {
@@ -134,22 +145,7 @@ std::string colourImageProblem(const sensor_msgs::Image& image) {
                                                                                        : 0;
   if (pixel_bytes == 0)
     return "unsupported colour encoding '" + image.encoding + "' (expected rgb8, bgr8 or mono8)";
-  std::string problem = gridSizeProblem("colour image", image.width, image.height, true);
-  if (!problem.empty())
-    return problem;
-  std::ostringstream why;
-  const std::uint64_t row_bytes = static_cast<std::uint64_t>(image.width) * pixel_bytes;
-  const std::uint64_t data_bytes = static_cast<std::uint64_t>(image.step) * image.height;
-  if (image.step < row_bytes) {
-    why << image.encoding << " colour image step " << image.step
-        << " is smaller than width x pixel size (" << image.width << " x " << pixel_bytes << " = "
-        << row_bytes << ")";
-  } else if (image.data.size() != data_bytes) {
-    why << image.encoding << " colour image data has " << image.data.size()
-        << " bytes, but step x height is " << image.step << " x " << image.height << " = "
-        << data_bytes;
-  }
-  return why.str();
+  return imageLayoutProblem(image, "colour image", pixel_bytes);
 }
 
 std::string cameraInfoProblem(const sensor_msgs::CameraInfo& info) {
