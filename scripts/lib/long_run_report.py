@@ -60,7 +60,10 @@ def offline_section(out):
     if not rows:
         return "## Offline (run_bag)\nnot run\n"
     data = [{"t": float(r["elapsed_s"]), "frames": int(r["frames"]), "rss": float(r["rss_mb"]),
-             "ms": float(r["ms_per_frame"]), "landmarks": int(r["landmarks"])} for r in rows]
+             "ms": float(r["ms_per_frame"]), "landmarks": int(r["landmarks"]),
+             # (columns added later: absent in older files)
+             "candidates": int(r.get("candidates") or 0),
+             "points": int(r.get("reconstruction_points") or 0)} for r in rows]
     warm = after_warm_up(data)
     xs = [r["t"] for r in warm]
     lines = ["## Offline (run_bag, frames rendered as needed)",
@@ -69,25 +72,33 @@ def offline_section(out):
              TABLE_HEAD,
              curve_line("resident memory", "MB", xs, [r["rss"] for r in warm]),
              curve_line("time per frame (render + pipeline)", "ms", xs, [r["ms"] for r in warm]),
-             curve_line("landmarks", "count", xs, [r["landmarks"] for r in warm]), "",
+             curve_line("landmarks", "count", xs, [r["landmarks"] for r in warm]),
+             curve_line("candidates (surfaces seen, not yet landmarks)", "count", xs,
+                        [r["candidates"] for r in warm]),
+             curve_line("reconstruction points", "count", xs, [r["points"] for r in warm]), "",
              f"landmarks: max {max(r['landmarks'] for r in data)} over the run; "
              f"memory: min {min(r['rss'] for r in data):.1f} MB, max "
              f"{max(r['rss'] for r in data):.1f} MB.", ""]
     csv_path = os.path.join(out, "offline", "resources.csv")
     png = os.path.join(out, "offline.png")
+    # One panel per column of resources.csv (1-based gnuplot columns; column 3 is elapsed_s).
+    panels = [("resident memory (MB)", 4, "RSS"),
+              ("ms per frame", 5, "render + pipeline, mean of 50 frames"),
+              ("landmarks", 6, "map landmarks"), ("candidates", 7, "candidates"),
+              ("points", 8, "reconstruction points")]
+    if "reconstruction_points" not in rows[0]:
+        panels = panels[:3]
+    plots = "\n".join(f"set ylabel '{label}'\n"
+                      f"plot '{csv_path}' every ::1 using ($3/60):{column} with lines lw 2 "
+                      f"title '{title}'" for label, column, title in panels)
     gnuplot(f"""
-set terminal png size 1000,900 noenhanced
+set terminal png size 1000,{300 * len(panels)} noenhanced
 set output '{png}'
 set datafile separator ','
-set multiplot layout 3,1 title 'run\\_bag on a generated sequence: resources over time'
+set multiplot layout {len(panels)},1 title 'run\\_bag on a generated sequence: resources over time'
 set xlabel 'wall time (min)'
 set grid
-set ylabel 'resident memory (MB)'
-plot '{csv_path}' every ::1 using ($3/60):4 with lines lw 2 title 'RSS'
-set ylabel 'ms per frame'
-plot '{csv_path}' every ::1 using ($3/60):5 with lines title 'render + pipeline, mean of 50 frames'
-set ylabel 'landmarks'
-plot '{csv_path}' every ::1 using ($3/60):6 with lines lw 2 title 'map landmarks'
+{plots}
 unset multiplot
 """)
     lines.append(f"plot: {png}\n")

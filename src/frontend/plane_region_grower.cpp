@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "quadric_slam/frontend/grid_flood.h"
+
 namespace quadric_slam {
 
 namespace {
@@ -189,34 +191,28 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::grow(
       queue.push_back(seed);
       state[seed] = 1;
       moments.add(moments.reference, n);
-      for (std::size_t head = 0; head < queue.size(); ++head) {
-        const int i = queue[head];
-        const int u = i % width, v = i / width;
+      floodFill4(width, height, queue, [&](int i, int j) {
+        if (!valid[j] || used[j] || state[j] == 1)
+          return false;
+        const pcl::PointNormal& q = cloud.points[j];
         const float zi = cloud.points[i].z;
-        const int neighbours[4] = {u > 0 ? i - 1 : -1, u + 1 < width ? i + 1 : -1,
-                                   v > 0 ? i - width : -1, v + 1 < height ? i + width : -1};
-        for (int j : neighbours) {
-          if (j < 0 || !valid[j] || used[j] || state[j] == 1)
-            continue;
-          const pcl::PointNormal& q = cloud.points[j];
-          if (std::abs(q.z - zi) > params_.max_depth_jump_factor * zi)
-            continue;
-          const Eigen::Vector3d p = pointOf(q);
-          const Eigen::Vector3d normal = normalOf(q);
-          const double agreement = n.dot(normal);
-          if (std::abs(agreement) < cos_angle)
-            continue;
-          if (std::abs(n.dot(p) - d) > pointThreshold(q.z))
-            continue;
-          state[j] = 1;
-          queue.push_back(j);
-          moments.add(p, agreement < 0 ? Eigen::Vector3d(-normal) : normal);
-          if (moments.count >= next_refit) {
-            moments.meanNormalPlane(n, d);
-            next_refit *= 2;
-          }
+        if (std::abs(q.z - zi) > params_.max_depth_jump_factor * zi)
+          return false;
+        const Eigen::Vector3d p = pointOf(q);
+        const Eigen::Vector3d normal = normalOf(q);
+        const double agreement = n.dot(normal);
+        if (std::abs(agreement) < cos_angle)
+          return false;
+        if (std::abs(n.dot(p) - d) > pointThreshold(q.z))
+          return false;
+        state[j] = 1;
+        moments.add(p, agreement < 0 ? Eigen::Vector3d(-normal) : normal);
+        if (moments.count >= next_refit) {
+          moments.meanNormalPlane(n, d);
+          next_refit *= 2;
         }
-      }
+        return true;
+      });
       // Fragments (at least min_fragment_points) are kept for merging; what stays below
       // min_points after merging is released.
       bool accepted = static_cast<int>(queue.size()) >=
@@ -401,27 +397,21 @@ void PlaneRegionGrower::fill(const pcl::PointCloud<pcl::PointNormal>& cloud,
     const Eigen::Vector3d n = region.plane.direction;
     const double d = n.dot(region.plane.point);
     queue = region.indices;
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const int i = queue[head];
-      const int u = i % width, v = i / width;
+    floodFill4(width, height, queue, [&](int i, int j) {
+      if (!valid[j] || used[j])
+        return false;
+      const pcl::PointNormal& q = cloud.points[j];
       const float zi = cloud.points[i].z;
-      const int neighbours[4] = {u > 0 ? i - 1 : -1, u + 1 < width ? i + 1 : -1,
-                                 v > 0 ? i - width : -1, v + 1 < height ? i + width : -1};
-      for (int j : neighbours) {
-        if (j < 0 || !valid[j] || used[j])
-          continue;
-        const pcl::PointNormal& q = cloud.points[j];
-        if (std::abs(q.z - zi) > params_.max_depth_jump_factor * zi)
-          continue;
-        if (std::abs(n.dot(normalOf(q))) < cos_angle)
-          continue;
-        if (std::abs(n.dot(pointOf(q)) - d) > pointThreshold(q.z))
-          continue;
-        used[j] = 1;
-        queue.push_back(j);
-        region.indices.push_back(j);
-      }
-    }
+      if (std::abs(q.z - zi) > params_.max_depth_jump_factor * zi)
+        return false;
+      if (std::abs(n.dot(normalOf(q))) < cos_angle)
+        return false;
+      if (std::abs(n.dot(pointOf(q)) - d) > pointThreshold(q.z))
+        return false;
+      used[j] = 1;
+      region.indices.push_back(j);
+      return true;
+    });
   }
 }
 

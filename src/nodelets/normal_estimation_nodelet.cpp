@@ -1,7 +1,12 @@
 // normal_estimation: depth image + camera_info -> organized PointCloud2 with xyz and normals.
 //
-// Subscribes  depth/image (sensor_msgs/Image, 32FC1 metres or 16UC1 millimetres)
-//             depth/camera_info (sensor_msgs/CameraInfo, the latest one is used)
+// Subscribes  depth/image (sensor_msgs/Image, 32FC1 metres or 16UC1 millimetres) through
+//             image_transport: ~image_transport picks the transport (default raw; e.g.
+//             compressedDepth when its plugin is installed)
+//             depth/camera_info (sensor_msgs/CameraInfo, the latest one is used; not paired with
+//             the image by stamp, so a camera_info that is bad, late or missing for some frames
+//             does not hold back the depth stream — the image is dropped only until a valid one
+//             has been received)
 // Parameters  config/normal_estimation.yaml (every key documented there)
 // Publishes   points_normals (sensor_msgs/PointCloud2, organized, fields x y z normal_x normal_y
 //             normal_z curvature, NaN where there is no data, the depth image's stamp; frame
@@ -11,6 +16,7 @@
 // Bad input (no camera_info yet, unsupported encoding, size mismatch, malformed buffer: see
 // ros/message_validation.h) and anything the core throws get an error, throttled per reason, and
 // the frame is dropped and counted on /diagnostics.
+#include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
 #include <pcl_conversions/pcl_conversions.h>
 #include <ros/ros.h>
@@ -62,7 +68,10 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
     cloud_pub_ = nh.advertise<sensor_msgs::PointCloud2>("points_normals", queue_size);
     info_sub_ =
         nh.subscribe("depth/camera_info", queue_size, &NormalEstimationNodelet::onCameraInfo, this);
-    depth_sub_ = nh.subscribe("depth/image", queue_size, &NormalEstimationNodelet::onDepth, this);
+    image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
+    depth_sub_ = image_transport_->subscribe(
+        "depth/image", queue_size, &NormalEstimationNodelet::onDepth, this,
+        image_transport::TransportHints("raw", ros::TransportHints(), private_nh));
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
@@ -124,7 +133,9 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
   std::mutex intrinsics_mutex_;
   CameraIntrinsics intrinsics_;
   bool have_intrinsics_ = false;
-  ros::Subscriber depth_sub_, info_sub_;
+  std::unique_ptr<image_transport::ImageTransport> image_transport_;
+  image_transport::Subscriber depth_sub_;
+  ros::Subscriber info_sub_;
   ros::Publisher cloud_pub_;
 };
 

@@ -10,7 +10,8 @@
 //   DIR/reconstruction.pcd   landmark points projected onto their surfaces (label = landmark id;
 //                            rgba = the pixel's colour when the input has RGB, alpha 255, else
 //                            the landmark's colour, alpha 0: ros/reconstruction_cloud.h)
-//   DIR/resources.csv        every --sample-every frames: resident memory, frame time, landmarks
+//   DIR/resources.csv        every --sample-every frames: resident memory, frame time, landmarks,
+//                            candidates and reconstruction points (what a long run may grow)
 // With --gt prints the ATE and RPE of the odometry (ate_rmse_m ...) and of SLAM (map_ate_rmse_m
 // ...). INPUT may also be a scene file (config/scenes/*.yaml): its frames are rendered as they are
 // needed (sim/synthetic_frame_source.h), so a sequence of any length runs without a bag; the truth
@@ -212,7 +213,8 @@ int main(int argc, char** argv) {
     }
     // Long-run curves: memory, time per frame and map size every sample_every frames.
     std::ofstream resources(o.out_dir + "/resources.csv");
-    resources << "frames,stamp_s,elapsed_s,rss_mb,ms_per_frame,landmarks\n";
+    resources << "frames,stamp_s,elapsed_s,rss_mb,ms_per_frame,landmarks,candidates,"
+                 "reconstruction_points\n";
     auto last_sample = std::chrono::steady_clock::now();
     if (!o.quiet) {
       std::cerr << "run_bag: " << o.input << ": " << total << " frames, config " << o.config_dir
@@ -263,7 +265,8 @@ int main(int argc, char** argv) {
                   << ',' << qs::residentMemoryBytes() / 1048576.0 << ','
                   << std::chrono::duration<double, std::milli>(now - last_sample).count() /
                          in_interval
-                  << ',' << slam.mapper().map().landmarks().size()
+                  << ',' << slam.mapper().map().landmarks().size() << ','
+                  << slam.mapper().map().candidates().size() << ',' << slam.reconstruction().size()
                   << std::endl;  // flushed: the curve can be watched during a long run
         last_sample = now;
       }
