@@ -13,6 +13,23 @@ std::string CameraIntrinsics::problem() const {
     why << "principal point must be finite";
   } else if (width <= 0 || height <= 0) {
     why << "image size must be positive (" << width << " x " << height << ")";
+  } else {
+    // Field of view of an axis of n pixels with focal length f: 2 atan(n / (2 f)).
+    const double fov_x = 2.0 * std::atan(width / (2.0 * fx));
+    const double fov_y = 2.0 * std::atan(height / (2.0 * fy));
+    const double deg = 180.0 / M_PI;
+    if (!(fov_x >= kMinFieldOfView && fov_x <= kMaxFieldOfView && fov_y >= kMinFieldOfView &&
+          fov_y <= kMaxFieldOfView)) {
+      why << "focal lengths (fx " << fx << ", fy " << fy << ") give a field of view of "
+          << fov_x * deg << " x " << fov_y * deg << " degrees for " << width << " x " << height
+          << " pixels; it must be within [" << kMinFieldOfView * deg << ", "
+          << kMaxFieldOfView * deg << "] degrees";
+    } else if (std::abs(cx - 0.5 * width) > (kMaxPrincipalPointOffset + 0.5) * width ||
+               std::abs(cy - 0.5 * height) > (kMaxPrincipalPointOffset + 0.5) * height) {
+      why << "principal point (" << cx << ", " << cy << ") lies more than "
+          << kMaxPrincipalPointOffset << " image sizes outside the " << width << " x " << height
+          << " image";
+    }
   }
   return why.str();
 }

@@ -271,6 +271,25 @@ TEST(MessageValidation, CameraInfoRules) {
   EXPECT_TRUE(mentions(qs::cameraInfoProblem(info), "principal point"));
   EXPECT_TRUE(mentions(qs::cameraInfoProblem(cameraInfo(0, 480)), "not an organized"));
   EXPECT_TRUE(mentions(qs::cameraInfoProblem(cameraInfo(100000, 100000)), "more than"));
+  // Finite but absurd: back-projection would give infinite or collapsed points.
+  for (const double focal : {1e-300, 1e-3, 1.0, 4e5, 1e300}) {
+    info = cameraInfo(640, 480);
+    info.K[0] = info.K[4] = focal;
+    EXPECT_TRUE(mentions(qs::cameraInfoProblem(info), "field of view")) << focal;
+  }
+  info = cameraInfo(640, 480);
+  info.K[2] = 1e12;
+  EXPECT_TRUE(mentions(qs::cameraInfoProblem(info), "outside the 640 x 480 image"));
+  // Real cameras pass: a Kinect (about 58 x 45 degrees), a fisheye-like 170 degrees, a long lens
+  // of 1 degree, a principal point off-centre (a crop).
+  for (const double focal : {525.0, 28.0, 36000.0}) {
+    info = cameraInfo(640, 480);
+    info.K[0] = info.K[4] = focal;
+    EXPECT_EQ(qs::cameraInfoProblem(info), "") << focal;
+  }
+  info = cameraInfo(640, 480);
+  info.K[2] = -600.0;
+  EXPECT_EQ(qs::cameraInfoProblem(info), "");
 }
 
 TEST(MessageValidation, DepthToCloudRefusesACloudDecimatedBelowTheMinimum) {
