@@ -449,6 +449,14 @@ TEST_F(HostileInputTest, NoMessageTakesTheManagerDown) {
                    },
                    {"normal_estimation: ignoring camera_info: focal lengths must be positive",
                     "odometry: ignoring camera_info: focal lengths must be positive"}});
+  cases.push_back({"camera_info finite but absurd fx 1e-300",
+                   [&](double t) {
+                     sensor_msgs::CameraInfo info = cameraInfo(kWidth, kHeight);
+                     info.K[0] = 1e-300;
+                     publishInfo(info, t);
+                   },
+                   {"normal_estimation: ignoring camera_info: focal lengths (fx 1e-300",
+                    "odometry: ignoring camera_info: focal lengths (fx 1e-300"}});
   cases.push_back({"camera_info 0 x 0",
                    [&](double t) { publishInfo(cameraInfo(0, 0), t); },
                    {"normal_estimation: ignoring camera_info: camera_info is 0 x 0",
