@@ -237,9 +237,9 @@ WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
     gauge = true;
   }
   if (params_.schur_marginalization && !marginal_prior_.empty()) {
-    // Landmarks of the prior that no window keyframe observes any more (their observations left
-    // with marginalised keyframes while a later one still saw them... then removed by a merge)
-    // are variables of the prior alone.
+    // Every landmark of the prior is normally observed in the window (a landmark is eliminated
+    // with its last observing keyframe, and a merged one is eliminated from the prior); a block
+    // is added anyway so that the prior always finds its variables.
     for (const PriorVariable& v : marginal_prior_.variables)
       if (v.kind == PriorVariable::Kind::kLandmark && map->landmarks().count(v.id) > 0)
         landmarkBlock(v.id);

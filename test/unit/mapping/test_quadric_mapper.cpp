@@ -94,6 +94,16 @@ TEST(QuadricMapper, ParamsValidate) {
   p = {};
   p.odometry_translation_sigma = p.odometry_translation_fraction = 0;
   EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = {};
+  p.keyframe_min_new_landmarks = 0;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = {};
+  p.keyframe_min_overlap = 1.5;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p.keyframe_min_overlap = -0.1;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p.keyframe_min_overlap = 1.0;
+  EXPECT_NO_THROW(p.validate());
   SlidingWindow::Params w;
   w.landmark_prior_inflation = 0.5;
   EXPECT_THROW(w.validate(), std::invalid_argument);
