@@ -39,6 +39,9 @@ void QuadricMapper::Params::validate() const {
   window.validate();
   requireRange(keyframe_translation > 0.0, "keyframe_translation", "(0, inf) m");
   requireRange(keyframe_rotation > 0.0, "keyframe_rotation", "(0, inf) rad");
+  requireRange(keyframe_min_new_landmarks >= 1, "keyframe_min_new_landmarks", "[1, inf)");
+  requireRange(keyframe_min_overlap >= 0.0 && keyframe_min_overlap <= 1.0, "keyframe_min_overlap",
+               "[0, 1]");
   requireRange(odometry_translation_sigma >= 0.0, "odometry_translation_sigma", "[0, inf) m");
   requireRange(odometry_translation_fraction >= 0.0, "odometry_translation_fraction", "[0, inf)");
   requireRange(odometry_rotation_sigma >= 0.0, "odometry_rotation_sigma", "[0, inf) rad");
@@ -173,18 +176,26 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
   result.update =
       map_.integrate(frame_index_, frame.stamp, valid, T_map_predicted, covariance_since_keyframe_);
 
-  // 3. Keyframe rule.
+  // 3. Keyframe rule: motion, or a view of the map the window does not hold yet.
   bool keyframe = first || T_keyframe_this.translation().norm() > params_.keyframe_translation ||
                   rotationAngle(T_keyframe_this) > params_.keyframe_rotation;
   Keyframe kf;
+  std::set<int> seen, new_to_window;
   for (size_t m = 0; m < valid.size(); ++m) {
     const MeasurementResult& r = result.update.measurements[m];
     if (r.fate != MeasurementFate::kLandmark && r.fate != MeasurementFate::kPromoted &&
         r.fate != MeasurementFate::kJoined)
       continue;
     kf.observations.push_back({r.id, valid[m]});
+    seen.insert(r.id);
     if (!window_.containsLandmark(r.id))
-      keyframe = true;
+      new_to_window.insert(r.id);
+  }
+  if (!seen.empty()) {
+    const double overlap = 1.0 - static_cast<double>(new_to_window.size()) / seen.size();
+    keyframe = keyframe ||
+               static_cast<int>(new_to_window.size()) >= params_.keyframe_min_new_landmarks ||
+               overlap < params_.keyframe_min_overlap;
   }
   result.association_seconds = secondsSince(start);
 
@@ -197,11 +208,13 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
     kf.T_previous_this = T_keyframe_this;
     kf.increment_covariance = first ? Matrix6d::Identity() : covariance_since_keyframe_;
     window_.addKeyframe(std::move(kf), map_);
-    for (size_t p = 0; p < result.update.promoted.size(); ++p) {
-      for (const CandidateObservation& o : result.update.promoted_history[p]) {
-        if (o.frame_index != frame_index_)
-          window_.addObservation(o.frame_index, {result.update.promoted[p], o.measurement});
-      }
+  }
+  // The earlier observations of a promoted candidate become factors in the window keyframes that
+  // made them (this frame's is in kf when it is a keyframe).
+  for (size_t p = 0; p < result.update.promoted.size(); ++p) {
+    for (const CandidateObservation& o : result.update.promoted_history[p]) {
+      if (o.frame_index != frame_index_)
+        window_.addObservation(o.frame_index, {result.update.promoted[p], o.measurement});
     }
   }
   // The earlier observations of candidates that joined a landmark become its factors in the window

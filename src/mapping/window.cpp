@@ -3,7 +3,9 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <array>
+#include <list>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -84,21 +86,28 @@ void SlidingWindow::foldIntoPrior(const Keyframe& keyframe, const WindowObservat
   prior.information += 0.5 * (information + information.transpose());
 }
 
+void SlidingWindow::dropFront() {
+  for (const WindowObservation& observation : keyframes_.front().observations) {
+    auto it = observation_counts_.find(observation.landmark_id);
+    if (--it->second == 0)
+      observation_counts_.erase(it);
+  }
+  keyframes_.pop_front();
+  first_keyframe_in_window_ = false;
+}
+
 void SlidingWindow::addKeyframe(Keyframe keyframe, const LandmarkRegistry& map) {
   if (!any_keyframe_)
     any_keyframe_ = first_keyframe_in_window_ = true;
   for (const WindowObservation& observation : keyframe.observations)
     countObservation(observation.landmark_id);
   keyframes_.push_back(std::move(keyframe));
+  if (params_.schur_marginalization)
+    return;  // the next optimize() marginalises what is over the size
   while (static_cast<int>(keyframes_.size()) > params_.size) {
-    for (const WindowObservation& observation : keyframes_.front().observations) {
+    for (const WindowObservation& observation : keyframes_.front().observations)
       foldIntoPrior(keyframes_.front(), observation, map);
-      auto it = observation_counts_.find(observation.landmark_id);
-      if (--it->second == 0)
-        observation_counts_.erase(it);
-    }
-    keyframes_.pop_front();
-    first_keyframe_in_window_ = false;
+    dropFront();
   }
 }
 
@@ -113,63 +122,102 @@ bool SlidingWindow::addObservation(int frame_index, const WindowObservation& obs
   return false;
 }
 
+// One optimisation problem and what the marginalisation needs to know about its blocks.
+struct SlidingWindow::Problem {
+  Problem() : problem(options()) {}
+  static ceres::Problem::Options options() {
+    ceres::Problem::Options o;
+    o.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    o.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    o.enable_fast_removal = true;  // keyframes and landmarks are removed when marginalised
+    return o;
+  }
+  PoseManifold pose_manifold;
+  std::map<QuadricClass, std::unique_ptr<QuadricManifold>> quadric_manifolds;
+  std::unique_ptr<ceres::LossFunction> huber;
+  ceres::Problem problem;
+  std::list<PoseBlock> poses;                 // front = oldest keyframe (stable addresses)
+  std::map<int, QuadricBlock> landmarks;      // landmark id -> block
+  std::map<const double*, PriorVariable> variables;  // every pose and landmark block
+  ceres::ResidualBlockId marginal_prior = nullptr;
+  PoseBlock identity{};                       // the constant pose of landmark priors
+
+  QuadricManifold* manifold(QuadricClass c) {
+    auto& m = quadric_manifolds[c];
+    if (!m)
+      m = std::make_unique<QuadricManifold>(c);
+    return m.get();
+  }
+  double* block(const PriorVariable& v) {
+    if (v.kind == PriorVariable::Kind::kLandmark) {
+      auto it = landmarks.find(v.id);
+      return it == landmarks.end() ? nullptr : it->second.data();
+    }
+    for (PoseBlock& pose : poses)
+      if (variables.at(pose.data()).id == v.id)
+        return pose.data();
+    return nullptr;
+  }
+  // Adds the marginalisation prior; false when one of its variables has no block here.
+  bool addPrior(const LinearizedPrior& prior) {
+    std::vector<double*> blocks;
+    for (const PriorVariable& v : prior.variables) {
+      double* b = block(v);
+      if (b == nullptr)
+        return false;
+      blocks.push_back(b);
+    }
+    marginal_prior = problem.AddResidualBlock(new LinearizedPriorCost(prior), nullptr, blocks);
+    return true;
+  }
+};
+
 WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
   last_ = WindowStatistics{};
   if (keyframes_.empty())
     return last_;
-  ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  PoseManifold pose_manifold;
-  std::map<QuadricClass, std::unique_ptr<QuadricManifold>> quadric_manifolds;
-  std::unique_ptr<ceres::LossFunction> huber;
+  Problem P;
+  ceres::Problem& problem = P.problem;
   if (params_.observation_huber > 0.0)
-    huber = std::make_unique<ceres::HuberLoss>(params_.observation_huber);
+    P.huber = std::make_unique<ceres::HuberLoss>(params_.observation_huber);
 
   // Poses, the gauge, odometry.
   const int n = static_cast<int>(keyframes_.size());
-  std::vector<PoseBlock> poses(n);
+  std::vector<double*> poses(n);
   for (int i = 0; i < n; ++i) {
-    poseToParameters(keyframes_[i].T_map_camera, poses[i].data());
-    problem.AddParameterBlock(poses[i].data(), kPoseParameterSize, &pose_manifold);
-  }
-  if (first_keyframe_in_window_) {
-    problem.SetParameterBlockConstant(poses[0].data());
-  } else {
-    const double st = params_.oldest_pose_translation_sigma;
-    const double sr = params_.oldest_pose_rotation_sigma;
-    const Matrix6d prior_covariance =
-        (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr)
-            .finished()
-            .asDiagonal();
-    problem.AddResidualBlock(PosePriorCost::Create(keyframes_[0].T_map_camera, prior_covariance),
-                             nullptr, poses[0].data());
-    ++last_.pose_priors;
+    P.poses.emplace_back();
+    poses[i] = P.poses.back().data();
+    poseToParameters(keyframes_[i].T_map_camera, poses[i]);
+    problem.AddParameterBlock(poses[i], kPoseParameterSize, &P.pose_manifold);
+    PriorVariable v;
+    v.kind = PriorVariable::Kind::kPose;
+    v.id = keyframes_[i].frame_index;
+    P.variables[poses[i]] = v;
   }
   for (int i = 1; i < n; ++i) {
     problem.AddResidualBlock(
         RelativePoseCost::Create(keyframes_[i].T_previous_this, keyframes_[i].increment_covariance),
-        nullptr, poses[i - 1].data(), poses[i].data());
+        nullptr, poses[i - 1], poses[i]);
     ++last_.odometry_factors;
   }
 
   // Landmarks and their observations.
-  std::map<int, QuadricBlock> landmarks;
   auto landmarkBlock = [&](int id) -> double* {
-    auto it = landmarks.find(id);
-    if (it != landmarks.end())
+    auto it = P.landmarks.find(id);
+    if (it != P.landmarks.end())
       return it->second.data();
     const QuadricModel& quadric = map->landmark(id).quadric_map;
-    QuadricBlock& block = landmarks[id];
-    quadricToParameters(quadric, block.data());
-    auto& manifold = quadric_manifolds[quadric.quadricClass()];
-    if (!manifold)
-      manifold = std::make_unique<QuadricManifold>(quadric.quadricClass());
-    problem.AddParameterBlock(block.data(), kQuadricParameterSize, manifold.get());
+    double* block = P.landmarks[id].data();
+    quadricToParameters(quadric, block);
+    problem.AddParameterBlock(block, kQuadricParameterSize, P.manifold(quadric.quadricClass()));
     if (landmarkFixed(id))
-      problem.SetParameterBlockConstant(block.data());
-    return block.data();
+      problem.SetParameterBlockConstant(block);
+    PriorVariable v;
+    v.kind = PriorVariable::Kind::kLandmark;
+    v.id = id;
+    v.quadric_class = quadric.quadricClass();
+    P.variables[block] = v;
+    return block;
   };
   for (int i = 0; i < n; ++i) {
     for (const WindowObservation& observation : keyframes_[i].observations) {
@@ -177,14 +225,44 @@ WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
       problem.AddResidualBlock(
           QuadricObservationCost::Create(observation.measurement.quadric_camera,
                                          observation.measurement.covariance),
-          huber.get(), poses[i].data(), block);
+          P.huber.get(), poses[i], block);
       ++last_.observation_factors;
     }
   }
-  PoseBlock identity;
-  poseToParameters(Eigen::Isometry3d::Identity(), identity.data());
+
+  // The gauge: the map's first keyframe, else the marginalisation prior, else a pose prior.
+  bool gauge = false;
+  if (first_keyframe_in_window_) {
+    problem.SetParameterBlockConstant(poses[0]);
+    gauge = true;
+  }
+  if (params_.schur_marginalization && !marginal_prior_.empty()) {
+    // Every landmark of the prior is normally observed in the window (a landmark is eliminated
+    // with its last observing keyframe, and a merged one is eliminated from the prior); a block
+    // is added anyway so that the prior always finds its variables.
+    for (const PriorVariable& v : marginal_prior_.variables)
+      if (v.kind == PriorVariable::Kind::kLandmark && map->landmarks().count(v.id) > 0)
+        landmarkBlock(v.id);
+    if (P.addPrior(marginal_prior_)) {
+      ++last_.marginalization_priors;
+      gauge = true;
+    }
+  }
+  if (!gauge) {
+    const double st = params_.oldest_pose_translation_sigma;
+    const double sr = params_.oldest_pose_rotation_sigma;
+    const Matrix6d prior_covariance =
+        (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr)
+            .finished()
+            .asDiagonal();
+    problem.AddResidualBlock(PosePriorCost::Create(keyframes_[0].T_map_camera, prior_covariance),
+                             nullptr, poses[0]);
+    ++last_.pose_priors;
+  }
+
+  poseToParameters(Eigen::Isometry3d::Identity(), P.identity.data());
   for (const auto& [id, prior] : priors_) {
-    if (landmarks.count(id) == 0 || landmarkFixed(id))
+    if (P.landmarks.count(id) == 0 || landmarkFixed(id))
       continue;
     const Eigen::LLT<Eigen::MatrixXd> information(prior.information);
     if (information.info() != Eigen::Success)
@@ -193,19 +271,19 @@ WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
         params_.landmark_prior_inflation * information.solve(Eigen::MatrixXd::Identity(
                                                prior.information.rows(), prior.information.cols()));
     if (last_.landmark_priors == 0) {
-      problem.AddParameterBlock(identity.data(), kPoseParameterSize, &pose_manifold);
-      problem.SetParameterBlockConstant(identity.data());
+      problem.AddParameterBlock(P.identity.data(), kPoseParameterSize, &P.pose_manifold);
+      problem.SetParameterBlockConstant(P.identity.data());
     }
     problem.AddResidualBlock(
         QuadricObservationCost::Create(prior.quadric_map,
                                        0.5 * (prior_covariance + prior_covariance.transpose())),
-        nullptr, identity.data(), landmarks.at(id).data());
+        nullptr, P.identity.data(), P.landmarks.at(id).data());
     ++last_.landmark_priors;
   }
 
   last_.keyframes = n;
   last_.pose_blocks = n;
-  last_.landmark_blocks = static_cast<int>(landmarks.size());
+  last_.landmark_blocks = static_cast<int>(P.landmarks.size());
   last_.parameter_blocks = problem.NumParameterBlocks();
   last_.residual_blocks = problem.NumResidualBlocks();
   last_.residuals = problem.NumResiduals();
@@ -222,15 +300,38 @@ WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
   last_.initial_cost = summary.initial_cost;
   last_.final_cost = summary.final_cost;
   last_.solution_usable = summary.IsSolutionUsable();
-  if (!last_.solution_usable)
-    return last_;
+  if (last_.solution_usable)
+    writeBack(&P, poses, map);
+  else
+    resetBlocks(&P, poses, *map);  // marginalise at the estimates the window started from
 
-  for (int i = 0; i < n; ++i)
-    keyframes_[i].T_map_camera = poseFromParameters(poses[i].data());
+  if (params_.schur_marginalization) {
+    while (static_cast<int>(keyframes_.size()) > params_.size) {
+      marginalizeOldest(&P, *map);
+      ++last_.marginalized_keyframes;
+    }
+    last_.marginal_prior_rows = static_cast<int>(marginal_prior_.J.rows());
+  }
+  return last_;
+}
+
+void SlidingWindow::resetBlocks(Problem* P, const std::vector<double*>& poses,
+                                const LandmarkRegistry& map) {
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    poseToParameters(keyframes_[i].T_map_camera, poses[i]);
+  for (auto& [id, block] : P->landmarks)
+    quadricToParameters(map.landmark(id).quadric_map, block.data());
+}
+
+void SlidingWindow::writeBack(Problem* P, const std::vector<double*>& poses,
+                              LandmarkRegistry* map) {
+  ceres::Problem& problem = P->problem;
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    keyframes_[i].T_map_camera = poseFromParameters(poses[i]);
 
   // Fixed landmarks keep their estimates and covariances: only the free ones are written back.
   std::vector<int> free_landmarks;
-  for (const auto& [id, block] : landmarks)
+  for (const auto& [id, block] : P->landmarks)
     if (!landmarkFixed(id))
       free_landmarks.push_back(id);
   std::map<int, Eigen::MatrixXd> covariances;
@@ -241,10 +342,10 @@ WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
     ceres::Covariance covariance(covariance_options);
     std::vector<std::pair<const double*, const double*>> blocks;
     for (int id : free_landmarks)
-      blocks.emplace_back(landmarks.at(id).data(), landmarks.at(id).data());
+      blocks.emplace_back(P->landmarks.at(id).data(), P->landmarks.at(id).data());
     if (covariance.Compute(blocks, &problem)) {
       for (int id : free_landmarks) {
-        const double* block = landmarks.at(id).data();
+        const double* block = P->landmarks.at(id).data();
         const int k = minimalDimension(map->landmark(id).quadric_map.quadricClass());
         RowMajor c(k, k);
         if (!covariance.GetCovarianceBlockInTangentSpace(block, block, c.data()) || !c.allFinite())
@@ -257,16 +358,148 @@ WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
   }
   for (int id : free_landmarks) {
     const QuadricModel& old = map->landmark(id).quadric_map;
+    double* block = P->landmarks.at(id).data();
     try {
-      const QuadricModel updated =
-          quadricFromParameters(landmarks.at(id).data(), old.quadricClass(), old.signature());
+      const QuadricModel updated = quadricFromParameters(block, old.quadricClass(), old.signature());
       auto it = covariances.find(id);
       map->setEstimate(id, updated, it != covariances.end() ? it->second : Eigen::MatrixXd());
     } catch (const std::invalid_argument&) {
-      // An invalid estimate (e.g. a scale pushed through zero): keep the previous one.
+      // An invalid estimate (e.g. a scale pushed through zero): keep the previous one, also as
+      // the linearisation point of a marginalisation.
+      quadricToParameters(old, block);
     }
   }
-  return last_;
+}
+
+void SlidingWindow::marginalizeOldest(Problem* P, const LandmarkRegistry& map) {
+  ceres::Problem& problem = P->problem;
+  const Keyframe& leaving = keyframes_.front();
+  double* leaving_pose = P->poses.front().data();
+
+  // The landmarks only the leaving keyframe observes leave with it.
+  std::map<int, int> leaving_counts;
+  for (const WindowObservation& observation : leaving.observations)
+    ++leaving_counts[observation.landmark_id];
+  std::vector<double*> eliminated_blocks = {leaving_pose};
+  std::vector<int> leaving_landmarks;
+  for (const auto& [id, count] : leaving_counts) {
+    if (observation_counts_.at(id) != count)
+      continue;
+    leaving_landmarks.push_back(id);
+    eliminated_blocks.push_back(P->landmarks.at(id).data());
+  }
+  // A landmark of the prior alone (no window observation left) leaves too.
+  for (const auto& [id, block] : P->landmarks)
+    if (observation_counts_.count(id) == 0 &&
+        std::find(leaving_landmarks.begin(), leaving_landmarks.end(), id) ==
+            leaving_landmarks.end()) {
+      leaving_landmarks.push_back(id);
+      eliminated_blocks.push_back(const_cast<double*>(block.data()));
+    }
+
+  // Every factor that touches an eliminated variable (the previous prior touches the oldest
+  // pose, or is replaced anyway).
+  std::set<ceres::ResidualBlockId> residuals;
+  for (double* block : eliminated_blocks) {
+    std::vector<ceres::ResidualBlockId> ids;
+    problem.GetResidualBlocksForParameterBlock(block, &ids);
+    residuals.insert(ids.begin(), ids.end());
+  }
+  if (P->marginal_prior != nullptr)
+    residuals.insert(P->marginal_prior);
+
+  // Their variables (constant blocks are known, not variables): eliminated ones first.
+  std::vector<const double*> order;
+  std::vector<bool> eliminate;
+  std::map<const double*, int> column_of;
+  int columns = 0, rows = 0;
+  auto addVariable = [&](const double* block, bool eliminated) {
+    if (column_of.count(block) > 0 || problem.IsParameterBlockConstant(block))
+      return;
+    column_of[block] = columns;
+    columns += problem.ParameterBlockTangentSize(block);
+    order.push_back(block);
+    eliminate.push_back(eliminated);
+  };
+  for (double* block : eliminated_blocks)
+    addVariable(block, true);
+  for (ceres::ResidualBlockId id : residuals) {
+    std::vector<double*> blocks;
+    problem.GetParameterBlocksForResidualBlock(id, &blocks);
+    for (double* block : blocks)
+      addVariable(block, false);
+    rows += problem.GetCostFunctionForResidualBlock(id)->num_residuals();
+  }
+
+  // The stacked, robustified Jacobian in the tangent spaces and the residuals at the estimate.
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(rows, columns);
+  Eigen::VectorXd r = Eigen::VectorXd::Zero(rows);
+  int row = 0;
+  for (ceres::ResidualBlockId id : residuals) {
+    std::vector<double*> blocks;
+    problem.GetParameterBlocksForResidualBlock(id, &blocks);
+    const int m = problem.GetCostFunctionForResidualBlock(id)->num_residuals();
+    std::vector<RowMajor> jacobians(blocks.size());
+    std::vector<double*> jacobian_pointers(blocks.size(), nullptr);
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      if (column_of.count(blocks[b]) == 0)
+        continue;
+      jacobians[b].resize(m, problem.ParameterBlockTangentSize(blocks[b]));
+      jacobian_pointers[b] = jacobians[b].data();
+    }
+    double cost = 0.0;
+    Eigen::VectorXd residual(m);
+    if (problem.EvaluateResidualBlock(id, true, &cost, residual.data(), jacobian_pointers.data()) &&
+        residual.allFinite()) {
+      r.segment(row, m) = residual;
+      for (std::size_t b = 0; b < blocks.size(); ++b)
+        if (jacobian_pointers[b] != nullptr && jacobians[b].allFinite())
+          A.block(row, column_of.at(blocks[b]), m, jacobians[b].cols()) = jacobians[b];
+    }
+    row += m;
+  }
+  std::vector<PriorVariable> variables;
+  for (const double* block : order) {
+    PriorVariable v = P->variables.at(block);
+    std::copy(block, block + v.ambientSize(), v.x0.begin());
+    variables.push_back(v);
+  }
+  marginal_prior_ = schurComplementPrior(variables, eliminate, A.transpose() * A,
+                                         A.transpose() * r);
+
+  // A landmark leaving the window keeps its estimate in the map; seen again, it re-enters with a
+  // prior from its covariance there.
+  for (int id : leaving_landmarks) {
+    if (landmarkFixed(id) || map.landmarks().count(id) == 0)
+      continue;
+    const QuadricLandmark& landmark = map.landmark(id);
+    if (landmark.covariance.size() == 0)
+      continue;
+    const Eigen::LLT<Eigen::MatrixXd> llt(landmark.covariance);
+    if (llt.info() != Eigen::Success)
+      continue;
+    const Eigen::MatrixXd information =
+        llt.solve(Eigen::MatrixXd::Identity(landmark.covariance.rows(), landmark.covariance.cols()));
+    priors_[id] = {landmark.quadric_map, 0.5 * (information + information.transpose())};
+  }
+
+  // The eliminated variables leave the problem with their factors; the new prior replaces the old.
+  for (double* block : eliminated_blocks)
+    problem.RemoveParameterBlock(block);
+  if (P->marginal_prior != nullptr && residuals.count(P->marginal_prior) > 0) {
+    // Removed with the oldest pose unless the prior did not touch it.
+    std::vector<ceres::ResidualBlockId> all;
+    problem.GetResidualBlocks(&all);
+    if (std::find(all.begin(), all.end(), P->marginal_prior) != all.end())
+      problem.RemoveResidualBlock(P->marginal_prior);
+  }
+  P->marginal_prior = nullptr;
+  for (int id : leaving_landmarks)
+    P->landmarks.erase(id);
+  P->poses.pop_front();
+  dropFront();
+  if (!marginal_prior_.empty() && !P->addPrior(marginal_prior_))
+    marginal_prior_ = {};
 }
 
 void SlidingWindow::mergeLandmark(int merged_id, int survivor_id,
@@ -284,6 +517,9 @@ void SlidingWindow::mergeLandmark(int merged_id, int survivor_id,
   }
   if (fixed_landmarks_.erase(merged_id) > 0)
     fixed_landmarks_.insert(survivor_id);
+  const int in_prior = marginal_prior_.find(PriorVariable::Kind::kLandmark, merged_id);
+  if (in_prior >= 0)
+    marginal_prior_ = eliminateVariable(marginal_prior_, static_cast<std::size_t>(in_prior));
   auto merged_prior = priors_.find(merged_id);
   if (merged_prior == priors_.end())
     return;
@@ -314,6 +550,7 @@ void SlidingWindow::clear() {
   keyframes_.clear();
   observation_counts_.clear();
   priors_.clear();
+  marginal_prior_ = {};
   fixed_landmarks_.clear();
   first_keyframe_in_window_ = any_keyframe_ = false;
   last_ = WindowStatistics{};

@@ -85,12 +85,15 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
   readParam(reader, "window_size", window.size, log);
   readParam(reader, "max_iterations", window.max_iterations, log);
   readParam(reader, "observation_huber", window.observation_huber, log);
+  readParam(reader, "schur_marginalization", window.schur_marginalization, log);
   readParam(reader, "oldest_pose_translation_sigma", window.oldest_pose_translation_sigma, log);
   readParam(reader, "oldest_pose_rotation_sigma", window.oldest_pose_rotation_sigma, log);
   readParam(reader, "landmark_prior_inflation", window.landmark_prior_inflation, log);
   readParam(reader, "compute_covariance", window.compute_covariance, log);
   readParam(reader, "keyframe_translation", mapper.keyframe_translation, log);
   readParam(reader, "keyframe_rotation", mapper.keyframe_rotation, log);
+  readParam(reader, "keyframe_min_new_landmarks", mapper.keyframe_min_new_landmarks, log);
+  readParam(reader, "keyframe_min_overlap", mapper.keyframe_min_overlap, log);
   readParam(reader, "odometry_translation_sigma", mapper.odometry_translation_sigma, log);
   readParam(reader, "odometry_translation_fraction", mapper.odometry_translation_fraction, log);
   readParam(reader, "odometry_rotation_sigma", mapper.odometry_rotation_sigma, log);

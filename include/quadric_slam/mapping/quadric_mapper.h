@@ -4,11 +4,16 @@
 //      optimised pose and the odometry since (the paper's "estimated previous pose concatenated
 //      with the latest odometry measurement"), with the odometry covariance accumulated since.
 //   2. Associate and count (mapping/landmark_registry.h, mapping/association.h).
-//   3. Keyframe rule: the frame becomes a keyframe when it is the first, when the camera moved more
-//      than keyframe_translation or turned more than keyframe_rotation since the last keyframe
-//      (odometry), or when it observes a landmark that has no factor in the window (a new landmark,
-//      or an old one seen again: a loop). Only keyframes carry factors; other frames' observations
-//      count towards promotion and observation counts only.
+//   3. Keyframe rule: a frame becomes a keyframe (a pose in the window, with factors) only when it
+//      adds information: it is the first; the camera moved more than keyframe_translation or
+//      turned more than keyframe_rotation since the last keyframe (odometry); or its view of the
+//      map is new: at least keyframe_min_new_landmarks of the landmarks it sees have no factor in
+//      the window (new landmarks, or old ones seen again: a loop), or fewer than
+//      keyframe_min_overlap of them have one (the view has moved on to other surfaces). Every
+//      other frame's observations still update the landmarks' evidence (association and
+//      observation counts, stamps, extents, candidates and their promotion) without adding a
+//      pose. A landmark promoted on such a frame gets factors from the window keyframes among the
+//      frames that made it, else at the next keyframe that sees it.
 //   4. On a keyframe, optimise the sliding window (mapping/window.h): bounded cost per frame.
 //   5. After the solve, merge the landmarks of the window that are the same surface as another
 //      landmark (mapping/landmark_merger.h): the merged landmark's window observations and folded
@@ -84,9 +89,11 @@ class QuadricMapper {
   struct Params {
     LandmarkRegistry::Params map;
     SlidingWindow::Params window;
-    // Keyframe rule (see above): m (> 0), rad (> 0).
+    // Keyframe rule (see above): m (> 0), rad (> 0), landmarks (int >= 1), fraction [0, 1].
     double keyframe_translation = 0.15;
     double keyframe_rotation = 0.17;
+    int keyframe_min_new_landmarks = 2;
+    double keyframe_min_overlap = 0.5;
     // Odometry noise model for frames without an increment covariance (1-sigma per increment):
     // sigma_t = translation_sigma + translation_fraction |dt|,
     // sigma_r = rotation_sigma + rotation_fraction |dtheta| + rotation_per_metre |dt|.

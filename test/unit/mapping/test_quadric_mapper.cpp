@@ -94,6 +94,16 @@ TEST(QuadricMapper, ParamsValidate) {
   p = {};
   p.odometry_translation_sigma = p.odometry_translation_fraction = 0;
   EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = {};
+  p.keyframe_min_new_landmarks = 0;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = {};
+  p.keyframe_min_overlap = 1.5;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p.keyframe_min_overlap = -0.1;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p.keyframe_min_overlap = 1.0;
+  EXPECT_NO_THROW(p.validate());
   SlidingWindow::Params w;
   w.landmark_prior_inflation = 0.5;
   EXPECT_THROW(w.validate(), std::invalid_argument);
@@ -164,15 +174,19 @@ TEST(QuadricMapper, WindowProblemStaysBoundedWhileTheMapGrows) {
     const WindowStatistics& w = r.frames[i].window;
     if (!r.frames[i].keyframe)
       continue;
-    if (w.keyframes < p.window.size)
+    // A full window solves size + 1 keyframes: the oldest is marginalised after the solve.
+    if (w.keyframes <= p.window.size)
       continue;
     ++filled;
-    EXPECT_EQ(w.keyframes, p.window.size);
-    EXPECT_EQ(w.pose_blocks, p.window.size);
-    // Odometry + gauge + at most one factor per measurement + landmark priors.
+    EXPECT_EQ(w.keyframes, p.window.size + 1);
+    EXPECT_EQ(w.pose_blocks, p.window.size + 1);
+    EXPECT_EQ(w.marginalized_keyframes, 1);
+    // Odometry + the marginalisation prior + at most one factor per measurement + landmark priors.
     EXPECT_LE(w.residual_blocks,
-              p.window.size + p.window.size * r.max_measurements + w.landmark_blocks);
-    EXPECT_LE(w.parameter_blocks, p.window.size + w.landmark_blocks + 1);
+              p.window.size + 1 + (p.window.size + 1) * r.max_measurements + w.landmark_blocks);
+    EXPECT_LE(w.parameter_blocks, p.window.size + 1 + w.landmark_blocks + 1);
+    // The prior is bounded by the window's variables (poses and landmarks of the window).
+    EXPECT_LE(w.marginal_prior_rows, 6 * (p.window.size + 1) + 9 * w.landmark_blocks);
     EXPECT_LE(w.iterations, p.window.max_iterations + 1);
     max_landmark_blocks = std::max(max_landmark_blocks, w.landmark_blocks);
     (i < n / 3 ? max_early : max_late) =
@@ -187,6 +201,43 @@ TEST(QuadricMapper, WindowProblemStaysBoundedWhileTheMapGrows) {
   EXPECT_GT(landmarks, 3 * max_landmark_blocks);
   EXPECT_LE(max_late, max_early * 3 / 2);
   EXPECT_LE(max_landmark_blocks, r.max_measurements * p.window.size);
+}
+
+// The keyframe rule: a camera that stays still in front of mapped surfaces adds no keyframes (no
+// motion, nothing new to the window), yet every frame still counts as an observation of the
+// landmarks it sees; moving on to other surfaces makes keyframes again.
+TEST(QuadricMapper, KeyframesOnlyWhenTheFrameAddsInformation) {
+  const std::vector<test::TrueLandmark> world = test::roomWorld();
+  const std::vector<Eigen::Isometry3d> circle = test::circleTrajectory(120, 1.0);
+  std::vector<Eigen::Isometry3d> poses(40, circle[0]);  // still
+  for (int i = 0; i < 60; ++i)
+    poses.push_back(circle[i]);  // then half a lap
+  QuadricMapper mapper;
+  const SyntheticRun r = run(&mapper, world, poses, 303);
+  int still_keyframes = 0, moving_keyframes = 0;
+  for (int i = 10; i < 40; ++i)
+    still_keyframes += r.frames[i].keyframe;
+  for (int i = 40; i < 100; ++i)
+    moving_keyframes += r.frames[i].keyframe;
+  int first_keyframes = 0;
+  for (int i = 0; i < 10; ++i)
+    first_keyframes += r.frames[i].keyframe;
+  std::cout << "keyframes: first 10 frames " << first_keyframes << ", still frames 10-39 "
+            << still_keyframes << ", moving frames 40-99 " << moving_keyframes << "\n";
+  EXPECT_EQ(still_keyframes, 0);
+  EXPECT_LE(first_keyframes, 3);  // the first frame and the promotions of the 5th
+  // Observations keep counting without keyframes: the landmarks seen from the still pose.
+  int counted = 0;
+  for (const auto& [id, landmark] : mapper.map().landmarks())
+    counted = std::max(counted, landmark.observations);
+  EXPECT_GE(counted, 40);
+  // Half a lap in 60 frames (6 m of arc, 180 degrees; motion alone makes a keyframe every third
+  // frame): new surfaces and motion make keyframes, but clearly fewer than frames.
+  EXPECT_GE(moving_keyframes, 15);
+  EXPECT_LE(moving_keyframes, 36);
+  // And the trajectory is still mapped: better than the drifting odometry.
+  const AbsoluteTrajectoryError ate;
+  EXPECT_LT(ate.evaluate(r.truth, r.mapper).rmse(), ate.evaluate(r.truth, r.odometry).rmse());
 }
 
 // Bad input is refused with a defined behaviour and leaves the map as it was.
