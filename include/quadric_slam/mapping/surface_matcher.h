@@ -16,7 +16,17 @@
 // maps its walls onto each other).
 //
 // A map's planes have no viewing side: a reference plane whose side is unknown enters twice, once
-// per normal sign; a frame's planes are oriented towards its camera.
+// per normal sign; a frame's planes are oriented towards its camera. Cylinder and cone axes are
+// compared up to their sign (a cone's quadric is the double cone: which nappe its frame names may
+// differ between a frame and the map).
+//
+// Unlike odometry/quadric_motion_guess.h (which confines hypotheses to its prior and scores each
+// distinct rotation once), a rotation shared by parallel surfaces (a table top and the floor) is
+// tried with each distinct line of translations its defining pair gives: deduplicating by the
+// rotation alone can skip the one line that holds the truth.
+//
+// Cost: grows with the number of landmarks; about 25 ms for a desk map of 11 landmarks and 0.6 s
+// for a kitchen map of about 100 (mostly parallel cabinet faces) on a loaded 2-core machine.
 #pragma once
 
 #include <Eigen/Core>
