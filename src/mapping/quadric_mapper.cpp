@@ -171,13 +171,21 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
     T_keyframe_this = kf.T_odom_camera.inverse() * T_odom_camera;
     T_map_predicted = kf.T_map_camera * T_keyframe_this;
   }
+  const bool relocalised = T_map_odom_relocalised_.has_value();
+  if (relocalised) {
+    T_map_predicted = *T_map_odom_relocalised_ * T_odom_camera;
+    // The odometry factor below then agrees with the initial poses (and carries no weight).
+    if (!first)
+      T_keyframe_this = window_.keyframes().back().T_map_camera.inverse() * T_map_predicted;
+  }
 
   // 2. Association and bookkeeping.
   result.update =
       map_.integrate(frame_index_, frame.stamp, valid, T_map_predicted, covariance_since_keyframe_);
 
-  // 3. Keyframe rule: motion, or a view of the map the window does not hold yet.
-  bool keyframe = first || T_keyframe_this.translation().norm() > params_.keyframe_translation ||
+  // 3. Keyframe rule: motion, a relocalisation, or a view of the map the window does not hold yet.
+  bool keyframe = first || relocalised ||
+                  T_keyframe_this.translation().norm() > params_.keyframe_translation ||
                   rotationAngle(T_keyframe_this) > params_.keyframe_rotation;
   Keyframe kf;
   std::set<int> seen, new_to_window;
@@ -206,8 +214,12 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
     kf.T_map_camera = T_map_predicted;
     kf.T_odom_camera = T_odom_camera;
     kf.T_previous_this = T_keyframe_this;
-    kf.increment_covariance = first ? Matrix6d::Identity() : covariance_since_keyframe_;
+    // After a relocalisation the motion since the previous keyframe is unknown: 100 m / 100 rad.
+    kf.increment_covariance = first         ? Matrix6d::Identity()
+                              : relocalised ? Matrix6d(1e4 * Matrix6d::Identity())
+                                            : covariance_since_keyframe_;
     window_.addKeyframe(std::move(kf), map_);
+    T_map_odom_relocalised_.reset();
   }
   // The earlier observations of a promoted candidate become factors in the window keyframes that
   // made them (this frame's is in kf when it is a keyframe).
@@ -290,6 +302,7 @@ void QuadricMapper::reset() {
   last_stamp_ = 0.0;
   T_odom_previous_ = Eigen::Isometry3d::Identity();
   T_map_odom_start_ = Eigen::Isometry3d::Identity();
+  T_map_odom_relocalised_.reset();
   covariance_since_keyframe_.setZero();
 }
 
@@ -308,6 +321,12 @@ void QuadricMapper::loadLandmarks(const std::vector<QuadricLandmark>& landmarks,
       window_.setLandmarkFixed(landmark.id);
   }
   T_map_odom_start_ = T_map_odom;
+}
+
+void QuadricMapper::relocalise(const Eigen::Isometry3d& T_map_odom) {
+  if (!isRigid(T_map_odom))
+    throw std::invalid_argument("QuadricMapper::relocalise: T_map_odom is not rigid");
+  T_map_odom_relocalised_ = T_map_odom;
 }
 
 void QuadricMapper::setLocalizationOnly(bool on) {

@@ -25,12 +25,15 @@ void TrackingRecovery::Params::validate() const {
   check(min_map_landmarks >= 0,
         "min_map_landmarks must be >= 0, got " + std::to_string(min_map_landmarks));
   check(max_frames >= 0, "max_frames must be >= 0, got " + std::to_string(max_frames));
+  relocaliser.validate();
 }
 
-TrackingRecovery::TrackingRecovery(const Params& params) : params_((params.validate(), params)) {}
+TrackingRecovery::TrackingRecovery(const Params& params)
+    : params_((params.validate(), params)), relocaliser_(params.relocaliser) {}
 
 void TrackingRecovery::trackingLost(int map_landmarks) {
   anchored_frames_ = 0;
+  verified_ = false;
   recovering_frames_ = 0;
   if (map_landmarks < params_.min_map_landmarks)
     return;  // nothing to anchor against, nothing to put out of place
@@ -42,8 +45,9 @@ void TrackingRecovery::trackingLost(int map_landmarks) {
 void TrackingRecovery::frameMapped(int landmark_associations) {
   if (!recovering_)
     return;
-  anchored_frames_ =
-      landmark_associations >= params_.min_landmark_associations ? anchored_frames_ + 1 : 0;
+  anchored_frames_ = landmark_associations >= params_.min_landmark_associations && poseVerified()
+                         ? anchored_frames_ + 1
+                         : 0;
   ++recovering_frames_;
   if (anchored_frames_ >= params_.confirm_frames) {
     recovering_ = false;
@@ -56,8 +60,18 @@ void TrackingRecovery::frameMapped(int landmark_associations) {
     anchored_frames_ = recovering_frames_ = 0;
 }
 
+void TrackingRecovery::relocalisationAttempted(bool found, bool reanchored) {
+  ++relocalisation_attempts_;
+  verified_ = verified_ || found;
+  if (reanchored) {
+    ++relocalisations_;
+    anchored_frames_ = 0;  // the anchoring frames count from the new pose
+  }
+}
+
 void TrackingRecovery::reset() {
   recovering_ = false;
+  verified_ = false;
   anchored_frames_ = recovering_frames_ = 0;
 }
 

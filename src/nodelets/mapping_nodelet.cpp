@@ -73,6 +73,7 @@
 #include "quadric_slam/frontend/support_colours.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
+#include "quadric_slam/mapping/recovery_relocalisation.h"
 #include "quadric_slam/mapping/tracking_recovery.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/ros/colour_image_buffer.h"
@@ -412,7 +413,27 @@ class MappingNodelet : public nodelet::Nodelet {
     if (use_rgb_)
       colourFrame(frame, stamp);
 
-    // 4. The mapper.
+    // 4. While the map waits to be anchored after a loss, a frame that does not anchor is first
+    // relocalised against the landmarks; where found, the odometry is re-anchored in the map
+    // (mapping/recovery_relocalisation.h).
+    if (recovery_.recovering() && !user_localization_only_) {
+      const RecoveryRelocalisation relocalisation = relocaliseWhileRecovering(
+          &recovery_, mapper_.get(), frame.observations, odometry.T_odom_camera, T_map_odom_);
+      if (relocalisation.attempted) {
+        if (relocalisation.reanchored)
+          NODELET_INFO("mapping: relocalised in the map with %d of %d surfaces (%.1f ms)",
+                       relocalisation.result.supporting_surfaces,
+                       relocalisation.result.usable_observations, 1e3 * relocalisation.seconds);
+        std::lock_guard<std::mutex> lock(stats_mutex_);
+        stats_.last_relocalisation = relocalisation.result.found
+                                         ? (relocalisation.reanchored ? "re-anchored"
+                                                                      : "found at the odometry's pose")
+                                         : relocalisation.result.message;
+        stats_.relocalisation_ms.add(1e3 * relocalisation.seconds);
+      }
+    }
+
+    // 5. The mapper.
     const MapperFrameResult result = mapper_->process(frame, odometry);
     if (result.status != FrameStatus::kOk) {
       dropFrame("mapper refused the frame: " + result.message);
@@ -425,7 +446,7 @@ class MappingNodelet : public nodelet::Nodelet {
     if (result.rejected_measurements > 0)
       observation_drops_.report("the mapper refused: " + result.message);
 
-    // 5. The reconstruction grows on keyframes (after the points of merged landmarks moved).
+    // 6. The reconstruction grows on keyframes (after the points of merged landmarks moved).
     if (result.keyframe) {
       applyMergesToReconstruction(result.merges, reconstruction_.get());
       addKeyframeToReconstruction(frame, result, mapper_->map(), reconstruction_.get());
@@ -698,6 +719,10 @@ class MappingNodelet : public nodelet::Nodelet {
     long frames_processed = 0, frames_dropped = 0, keyframes = 0, resets = 0;
     long frames_lost = 0;  // odometry lost track: nothing of the frame reached the map
     int losses = 0, recoveries = 0, recovery_timeouts = 0;
+    bool recovering = false;
+    int relocalisation_attempts = 0, relocalisations = 0;
+    std::string last_relocalisation = "none";  // the latest attempt's outcome
+    RecentDurations relocalisation_ms{100};   // of the latest attempts
     long observations = 0, observations_dropped = 0, total_to_landmarks = 0, total_promoted = 0;
     std::string last_drop_reason, last_observation_problem;
     FrameStats last;
@@ -733,6 +758,9 @@ class MappingNodelet : public nodelet::Nodelet {
     stats_.losses = recovery_.losses();
     stats_.recoveries = recovery_.recoveries();
     stats_.recovery_timeouts = recovery_.timeouts();
+    stats_.recovering = recovery_.recovering();
+    stats_.relocalisation_attempts = recovery_.relocalisationAttempts();
+    stats_.relocalisations = recovery_.relocalisations();
     stats_.loaded_from = loaded_from_;
   }
 
@@ -782,6 +810,13 @@ class MappingNodelet : public nodelet::Nodelet {
     status.add("tracking losses", s.losses);
     status.add("recoveries (pose anchored in the map again)", s.recoveries);
     status.add("recoveries given up (recovery_max_frames)", s.recovery_timeouts);
+    status.add("recovering (localisation only until anchored)", s.recovering ? "yes" : "no");
+    status.add("relocalisation attempts", s.relocalisation_attempts);
+    status.add("relocalisations (odometry re-anchored in the map)", s.relocalisations);
+    status.add("last relocalisation", s.last_relocalisation);
+    const TimingSummary relocalisation = s.relocalisation_ms.summary();
+    status.add("relocalisation time median (ms)", relocalisation.median_ms);
+    status.add("relocalisation time p95 (ms)", relocalisation.p95_ms);
     status.add("observations received", s.observations);
     status.add("observations dropped", s.observations_dropped);
     status.add("last observation problem", s.last_observation_problem);

@@ -114,6 +114,17 @@ void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Par
   readParam(reader, "recovery_confirm_frames", params.confirm_frames, log);
   readParam(reader, "recovery_min_map_landmarks", params.min_map_landmarks, log);
   readParam(reader, "recovery_max_frames", params.max_frames, log);
+  Relocaliser::Params& relocaliser = params.relocaliser;
+  readParam(reader, "relocalisation_enabled", relocaliser.enabled, log);
+  readParam(reader, "relocalisation_min_supporting_surfaces", relocaliser.min_supporting_surfaces,
+            log);
+  readParam(reader, "relocalisation_max_ambiguity", relocaliser.max_ambiguity, log);
+  readParam(reader, "relocalisation_extent_margin", relocaliser.extent_margin, log);
+  readParam(reader, "relocalisation_min_plane_points", relocaliser.min_plane_points, log);
+  readParam(reader, "relocalisation_max_angle_difference",
+            relocaliser.matcher.max_angle_difference, log);
+  readParam(reader, "relocalisation_max_offset_difference",
+            relocaliser.matcher.max_offset_difference, log);
   params.validate();
 }
 

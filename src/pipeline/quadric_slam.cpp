@@ -61,6 +61,7 @@ void QuadricSlam::reset() {
   reconstruction_.clear();
   recovery_.reset();
   mapper_.setLocalizationOnly(false);
+  T_map_odom_.setIdentity();
   has_stamp_ = false;
 }
 
@@ -124,14 +125,21 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
   if (mapper_.localizationOnly() != recovery_.recovering())
     mapper_.setLocalizationOnly(recovery_.recovering());
   out.recovering = recovery_.recovering();
+  if (recovery_.recovering() && !recovery_.poseVerified())
+    out.relocalisation = timer_.time("relocalisation", [&] {
+      return relocaliseWhileRecovering(&recovery_, &mapper_, out.measurements.observations,
+                                       out.odometry.T_odom_camera, T_map_odom_);
+    });
 
   OdometryInput odometry_input;
   odometry_input.T_odom_camera = out.odometry.T_odom_camera;
   out.mapping =
       timer_.time("mapping", [&] { return mapper_.process(out.measurements, odometry_input); });
   out.mapped = out.mapping.status == FrameStatus::kOk;
-  if (out.mapped)
+  if (out.mapped) {
     recovery_.frameMapped(landmarkAssociations(out.mapping.update));
+    T_map_odom_ = out.mapping.T_map_odom;
+  }
   if (!out.mapped) {
     out.message = "mapper refused the frame: " + out.mapping.message;
     return out;

@@ -300,9 +300,10 @@ int main(int argc, char** argv) {
     if (!o.odometry_only) {
       std::printf(
           "mapping after losses: lost %d times, recovered %d, gave up %d, frames localising only "
-          "%zu\n",
+          "%zu, relocalised %d of %d attempts\n",
           slam.recovery().losses(), slam.recovery().recoveries(), slam.recovery().timeouts(),
-          frames_recovering);
+          frames_recovering, slam.recovery().relocalisations(),
+          slam.recovery().relocalisationAttempts());
       std::printf("observations per frame:");
       for (const auto& [name, count] : observations_per_class)
         std::printf(" %s %.2f", name.c_str(),

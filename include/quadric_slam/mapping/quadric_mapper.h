@@ -41,6 +41,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -138,6 +139,13 @@ class QuadricMapper {
   void setLocalizationOnly(bool on);
   bool localizationOnly() const { return localization_only_; }
 
+  // The camera was relocalised in the map after a loss of tracking (mapping/relocaliser.h): the
+  // odometry since the latest keyframe does not hold across the loss, so the next accepted frame
+  // is predicted at T_map_odom T_odom_camera, becomes a keyframe, and its odometry factor to the
+  // previous keyframe carries no information (the motion across the loss is unknown). Throws
+  // std::invalid_argument when T_map_odom is not rigid.
+  void relocalise(const Eigen::Isometry3d& T_map_odom);
+
   // Merges every pair of landmarks of the map that are the same surface, repeatedly until none
   // is left (call it before saving a map). Returns the merges in order; none in localisation-only
   // mode or with merging disabled.
@@ -165,6 +173,8 @@ class QuadricMapper {
   bool localization_only_ = false;
   // Where the first frame after a reset or a load is placed: T_map_predicted = this T_odom_camera.
   Eigen::Isometry3d T_map_odom_start_ = Eigen::Isometry3d::Identity();
+  // Set by relocalise() until the next keyframe uses it.
+  std::optional<Eigen::Isometry3d> T_map_odom_relocalised_;
   double last_stamp_ = 0.0;
   Eigen::Isometry3d T_odom_previous_ = Eigen::Isometry3d::Identity();
   Matrix6d covariance_since_keyframe_ = Matrix6d::Zero();  // body tangent of the latest frame

@@ -4,13 +4,19 @@
 // would enter the map in the wrong place. So after a loss the mapper only localises: it associates
 // the frame's surfaces with the landmarks it already has (nothing new is promoted, landmarks are
 // held fixed) until enough of them agree, in enough consecutive frames, that the pose is anchored
-// in the map again; then mapping resumes. With too few landmarks to anchor against, mapping
-// resumes at once (there is nothing to put out of place). Without relocalisation against the map
-// (the camera lost far from where it was), it waits until the view returns, unless max_frames
-// lets it give up.
+// in the map again; then mapping resumes. With relocalisation enabled, frames count as anchoring
+// only after the relocaliser has confirmed the pose (poseVerified()). With too few landmarks to anchor against, mapping
+// resumes at once (there is nothing to put out of place). When the camera moved while the
+// odometry was blind, the odometry's pose associates with nothing: then the frame's surfaces are
+// matched against the map's landmarks with no pose prior (mapping/relocaliser.h,
+// mapping/recovery_relocalisation.h), the odometry is re-anchored in the map at the relocalised
+// pose (relocalised()), and the anchoring and confirmation above run from there. With
+// relocalisation disabled, or when it finds nothing, it waits until the view returns, unless
+// max_frames lets it give up.
 #pragma once
 
 #include "quadric_slam/mapping/landmark_registry.h"
+#include "quadric_slam/mapping/relocaliser.h"
 
 namespace quadric_slam {
 
@@ -31,6 +37,8 @@ class TrackingRecovery {
     // (the default) waits until the view returns to mapped surfaces. Resuming without an anchor
     // lets the map continue from the odometry's pose, so surfaces seen again may be mapped twice.
     int max_frames = 0;
+    // Relocalisation against the map while recovering (config/mapping.yaml relocalisation_*).
+    Relocaliser::Params relocaliser;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -46,20 +54,35 @@ class TrackingRecovery {
   void frameMapped(int landmark_associations);
   // True while the pose is not anchored in the map again: the mapper must localise only.
   bool recovering() const { return recovering_; }
+  // While recovering with relocalisation enabled: the relocaliser has found the pose since the
+  // loss (at the odometry's pose, or re-anchored there); until then frames do not count as
+  // anchoring, since a few associations of large planes (a floor, a wall) also come at a wrong
+  // pose. Always true with relocalisation disabled.
+  bool poseVerified() const { return verified_ || !params_.relocaliser.enabled; }
+  // A relocalisation attempt of a recovering frame: whether it found the pose, and whether it
+  // re-anchored the odometry there.
+  void relocalisationAttempted(bool found, bool reanchored);
   // Losses since the start, recoveries completed, and recoveries given up after max_frames.
   int losses() const { return losses_; }
   int recoveries() const { return recoveries_; }
   int timeouts() const { return timeouts_; }
+  // Relocalisation attempts since the start, and those that re-anchored the odometry in the map.
+  int relocalisationAttempts() const { return relocalisation_attempts_; }
+  int relocalisations() const { return relocalisations_; }
   void reset();
 
   const Params& params() const { return params_; }
+  const Relocaliser& relocaliser() const { return relocaliser_; }
 
  private:
   Params params_;
+  Relocaliser relocaliser_;
   bool recovering_ = false;
+  bool verified_ = false;
   int anchored_frames_ = 0;
   int recovering_frames_ = 0;
   int losses_ = 0, recoveries_ = 0, timeouts_ = 0;
+  int relocalisation_attempts_ = 0, relocalisations_ = 0;
 };
 
 }  // namespace quadric_slam

@@ -35,7 +35,11 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
                        QuadricReconstruction::Params& reconstruction, ParamLog& log);
 
 // config/mapping.yaml, what the map does after a loss of tracking (mapping/tracking_recovery.h):
-// recovery_min_landmark_associations, recovery_confirm_frames, recovery_min_map_landmarks, recovery_max_frames.
+// recovery_min_landmark_associations, recovery_confirm_frames, recovery_min_map_landmarks, recovery_max_frames;
+// and the relocalisation against the map while recovering (mapping/relocaliser.h):
+// relocalisation_enabled, relocalisation_min_supporting_surfaces, relocalisation_max_ambiguity,
+// relocalisation_extent_margin, relocalisation_min_plane_points,
+// relocalisation_max_angle_difference, relocalisation_max_offset_difference.
 void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Params& params,
                                 ParamLog& log);
 

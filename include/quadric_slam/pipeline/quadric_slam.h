@@ -15,9 +15,11 @@
 //      points of landmarks the mapper merged), coloured from frame.rgb when the frame has one
 //      (frontend/support_colours.h: RGB registered to depth). A frame whose odometry is lost
 //      reaches no mapper; after a loss the mapper localises only until the surfaces anchor the
-//      pose in the map again (mapping/tracking_recovery.h).
-// Every stage is timed under its name (timer()): normals, segmentation, odometry, mapping,
-// reconstruction.
+//      pose in the map again (mapping/tracking_recovery.h); while it waits, a frame that does not
+//      anchor is first relocalised against the map's landmarks, and the odometry re-anchored in
+//      the map where it was found (mapping/recovery_relocalisation.h).
+// Every stage is timed under its name (timer()): normals, segmentation, odometry, relocalisation
+// (only frames that tried), mapping, reconstruction.
 #pragma once
 
 #include <pcl/point_cloud.h>
@@ -35,6 +37,7 @@
 #include "quadric_slam/io/param_reader.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
+#include "quadric_slam/mapping/recovery_relocalisation.h"
 #include "quadric_slam/mapping/tracking_recovery.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
 #include "quadric_slam/types/observation.h"
@@ -77,6 +80,8 @@ struct SlamFrameResult {
   // The mapper localised only (after a loss of tracking; nothing was added to the map). Also true
   // for a lost frame while the map still waits to be anchored.
   bool recovering = false;
+  // The relocalisation attempt of a recovering frame (attempted = false when none was needed).
+  RecoveryRelocalisation relocalisation;
   MapperFrameResult mapping;
 };
 
@@ -118,6 +123,8 @@ class QuadricSlam {
   StageTimer timer_;
   bool has_stamp_ = false;
   double last_stamp_ = 0.0;
+  // The mapper's latest map->odom correction (of the latest mapped frame).
+  Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
   pcl::PointCloud<pcl::PointNormal> cloud_;  // storage reused from frame to frame
   Segmentation segmentation_;
 };

@@ -11,6 +11,7 @@ using quadric_slam::TrackingRecovery;
 
 TEST(TrackingRecovery, MapsUntilALossThenWaitsForConsecutiveAnchoredFrames) {
   TrackingRecovery::Params params;
+  params.relocaliser.enabled = false;  // the counting alone (verification: below)
   params.min_landmark_associations = 3;
   params.confirm_frames = 2;
   TrackingRecovery recovery(params);
@@ -34,6 +35,7 @@ TEST(TrackingRecovery, MapsUntilALossThenWaitsForConsecutiveAnchoredFrames) {
 
 TEST(TrackingRecovery, ALossDuringRecoveryRestartsTheCount) {
   TrackingRecovery::Params params;
+  params.relocaliser.enabled = false;
   params.confirm_frames = 3;
   TrackingRecovery recovery(params);
   recovery.trackingLost(10);
@@ -87,5 +89,39 @@ TEST(TrackingRecovery, BadParametersAreNamed) {
   }
   params = {};
   params.min_landmark_associations = 0;
+  EXPECT_THROW(TrackingRecovery{params}, std::invalid_argument);
+}
+
+// With relocalisation enabled, associations count only once the relocaliser has found the pose
+// since the loss (a floor and two walls also associate at a wrong pose); a new loss asks again.
+TEST(TrackingRecovery, WithRelocalisationFramesAnchorOnlyAfterThePoseIsConfirmed) {
+  TrackingRecovery::Params params;
+  params.confirm_frames = 2;
+  TrackingRecovery recovery(params);
+  recovery.trackingLost(10);
+  EXPECT_FALSE(recovery.poseVerified());
+  recovery.frameMapped(8);
+  recovery.frameMapped(8);
+  recovery.frameMapped(8);
+  EXPECT_TRUE(recovery.recovering()) << "resumed on associations the relocaliser never confirmed";
+  recovery.relocalisationAttempted(/*found=*/false, /*reanchored=*/false);
+  recovery.frameMapped(8);
+  recovery.frameMapped(8);
+  EXPECT_TRUE(recovery.recovering());
+  recovery.relocalisationAttempted(/*found=*/true, /*reanchored=*/true);
+  EXPECT_TRUE(recovery.poseVerified());
+  recovery.frameMapped(8);
+  EXPECT_TRUE(recovery.recovering());
+  recovery.frameMapped(8);
+  EXPECT_FALSE(recovery.recovering());
+  EXPECT_EQ(recovery.relocalisationAttempts(), 2);
+  EXPECT_EQ(recovery.relocalisations(), 1);
+  recovery.trackingLost(10);
+  EXPECT_FALSE(recovery.poseVerified()) << "a new loss needs a new confirmation";
+}
+
+TEST(TrackingRecovery, RelocaliserParametersAreValidated) {
+  TrackingRecovery::Params params;
+  params.relocaliser.max_ambiguity = 1.5;
   EXPECT_THROW(TrackingRecovery{params}, std::invalid_argument);
 }

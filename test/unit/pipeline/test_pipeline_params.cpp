@@ -114,4 +114,9 @@ TEST(PipelineParams, MappingYamlKeysAreAllRead) {
   EXPECT_EQ(recovery.confirm_frames, file["recovery_confirm_frames"].as<int>());
   EXPECT_EQ(recovery.min_landmark_associations,
             file["recovery_min_landmark_associations"].as<int>());
+  EXPECT_EQ(recovery.relocaliser.enabled, file["relocalisation_enabled"].as<bool>());
+  EXPECT_EQ(recovery.relocaliser.min_supporting_surfaces,
+            file["relocalisation_min_supporting_surfaces"].as<int>());
+  EXPECT_DOUBLE_EQ(recovery.relocaliser.matcher.max_offset_difference,
+                   file["relocalisation_max_offset_difference"].as<double>());
 }
