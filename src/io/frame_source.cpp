@@ -24,8 +24,15 @@ void validateReaderParams(double max_rgb_difference, const CameraIntrinsics& int
   }
   if (intrinsics_override.fx != 0.0) {
     CameraIntrinsics check = intrinsics_override;
-    if (check.width == 0 && check.height == 0)
-      check.width = check.height = 1;
+    if (check.width == 0 && check.height == 0) {
+      // The size comes from the images (checked with it on every frame); until then assume the
+      // principal point near the image centre, so the field-of-view rule has a size to work with.
+      const auto axis = [](double c) {
+        return std::isfinite(c) && c >= 0.5 && c < 1e6 ? static_cast<int>(std::lround(2 * c)) : 1;
+      };
+      check.width = axis(check.cx);
+      check.height = axis(check.cy);
+    }
     const std::string problem = check.problem();
     if (!problem.empty())
       throw std::invalid_argument("intrinsics: " + problem);
