@@ -233,8 +233,12 @@ class Odometry:
                 return False, init
             T = T.numpy()
             return bool(np.all(np.isfinite(T)) and fitness > 0), T
-        result = o3d.pipelines.registration.registration_icp(
-            source, target, 2.0 * self.voxel, init, self.estimation, self.criteria)
+        try:
+            result = o3d.pipelines.registration.registration_icp(
+                source, target, 2.0 * self.voxel, init, self.estimation, self.criteria)
+        except RuntimeError:
+            # An empty target (a frame without valid depth within depth_max) has no normals.
+            return False, init
         return bool(result.fitness > 0.3), np.asarray(result.transformation)
 
 
