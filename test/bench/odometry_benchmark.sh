@@ -113,7 +113,7 @@ done
 
 # Writes one result row (tab-separated) to $out/rows.tsv:
 # sequence rate method ate rpe frames pairs failures odo_median odo_p95 prep_median prep_p95
-# frame_ms status
+# frame_ms status wrong_steps
 rows="$out/rows.tsv"
 : >"$rows"
 
@@ -125,9 +125,14 @@ evaluate_row() {  # sequence rate method trajectory timing.json kind(ours|open3d
   ate=$(awk '$1 == "ate_rmse_m" {print $2}' <<<"$eval_out")
   rpe=$(awk '$1 == "rpe_m_per_s" {print $2}' <<<"$eval_out")
   pairs=$(awk '$1 == "pairs" {print $2}' <<<"$eval_out")
-  "$py" - "$timing" "$kind" "$seq" "$rate" "$method" "$ate" "$rpe" "$pairs" "$status" >>"$rows" <<'PY'
+  # Consecutive-frame steps off by more than 5 cm or 5 degrees (test/bench/step_errors.py).
+  local wrong
+  wrong=$("$py" "$QS_ROOT/test/bench/step_errors.py" --gt "$gt" --est "$traj" |
+    awk '$1 == "steps" {n = $2} $1 == "wrong_steps" {w = $2} END {print w "/" n}')
+  "$py" - "$timing" "$kind" "$seq" "$rate" "$method" "$ate" "$rpe" "$pairs" "$status" "$wrong" \
+    >>"$rows" <<'PY'
 import json, sys
-timing, kind, seq, rate, method, ate, rpe, pairs, status = sys.argv[1:]
+timing, kind, seq, rate, method, ate, rpe, pairs, status, wrong = sys.argv[1:]
 t = json.load(open(timing))
 st = t["stages"]
 def get(stage, key):
@@ -141,7 +146,7 @@ else:
     frame_ms = get("total", "median_ms")
 print("\t".join([seq, rate, method, ate, rpe, str(t["frames"]), pairs, failures,
                  get(odo, "median_ms"), get(odo, "p95_ms"), get(prep, "median_ms"),
-                 get(prep, "p95_ms"), frame_ms, status]))
+                 get(prep, "p95_ms"), frame_ms, status, wrong]))
 PY
 }
 
@@ -312,10 +317,13 @@ lines = [
     "trajectory. Status = ok/degenerate/lost frames of the run. Timing: ours = the odometry "
     "stage of timing.json (prep = the normals stage), frame ms = the run's wall time per frame "
     "(everything, PNG reading included); Open3D = the whole per-frame cost from decoded images "
-    "(prep = RGBD image / cloud + normals, then the odometry call), OMP_NUM_THREADS=1.",
+    "(prep = RGBD image / cloud + normals, then the odometry call), OMP_NUM_THREADS=1. Wrong steps: "
+    "consecutive estimated frames whose relative motion is off the truth's by more than 5 cm or "
+    "5 degrees, of all steps (test/bench/step_errors.py; a lost frame holds its pose, so its step "
+    "counts as wrong when the camera moved).",
     "",
-    "| sequence | rate | method | ATE RMSE (m) | RPE (m/s) | frames | ATE pairs | failed | odometry median ms | odometry p95 ms | prep median ms | prep p95 ms | frame ms | status |",
-    "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    "| sequence | rate | method | ATE RMSE (m) | RPE (m/s) | frames | ATE pairs | failed | odometry median ms | odometry p95 ms | prep median ms | prep p95 ms | frame ms | status | wrong steps |",
+    "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
 ]
 for r in rows:
     lines.append("| " + " | ".join(r) + " |")
