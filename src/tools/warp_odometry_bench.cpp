@@ -18,10 +18,12 @@
 //
 //   warp_odometry_bench [--frame PNG]... [--intrinsics fx,fy,cx,cy] [--config DIR] [--out DIR]
 //                       [--steps "5 10 ..."] [--motions-per-step N] [--seed N] [--no-guess]
-//                       [--quiet]
+//                       [--no-noise] [--quiet]
 //   --frame PNG: a TUM depth PNG (5000 units per metre), repeatable; intrinsics from the name of
 //     its folder (fr1/fr2/fr3, see io/tum_folder_reader.h) unless --intrinsics. Default: the depth
 //     frames of ../shared/data/tum_frames (fr1_xyz, fr2_desk, fr3_long_office_household).
+//   --no-noise: the warped frame without fresh depth noise (default: Kinect v1 axial noise after
+//     Nguyen et al. 2012 is added, as a second measurement of the surface would have).
 //   --out DIR: writes DIR/trials.csv (one row per trial), DIR/summary.csv and DIR/summary.md.
 // Prints the Markdown table.
 #include <algorithm>
@@ -64,13 +66,14 @@ struct Options {
   unsigned seed = 1;
   bool guess = true;
   bool quiet = false;
+  bool depth_noise = true;  // fresh axial noise on the warped frame (a second measurement)
 };
 
 void usage() {
   std::cerr << "usage: warp_odometry_bench [--frame PNG]... [--intrinsics fx,fy,cx,cy] "
                "[--config DIR] [--out DIR]\n"
                "       [--steps \"5 10 15 20 25 30\"] [--motions-per-step N] [--seed N] "
-               "[--no-guess] [--quiet]\n";
+               "[--no-guess] [--no-noise] [--quiet]\n";
 }
 
 std::vector<std::string> defaultFrames() {
@@ -117,6 +120,8 @@ Options parse(int argc, char** argv) {
         throw std::invalid_argument("--motions-per-step must be >= 1");
     } else if (arg == "--seed") {
       o.seed = static_cast<unsigned>(std::stoul(value()));
+    } else if (arg == "--no-noise") {
+      o.depth_noise = false;
     } else if (arg == "--no-guess") {
       o.guess = false;
     } else if (arg == "--quiet") {
@@ -191,6 +196,22 @@ double percentile(std::vector<double> v, double q) {
   return v[static_cast<std::size_t>(std::round(q * (v.size() - 1)))];
 }
 
+// A second measurement of the surface: the warped depths carry the reference frame's noise (it
+// moves with the surface), and a real second frame adds its own. Axial noise of a Kinect v1 after
+// Nguyen et al. 2012: sigma(z) = 0.0012 + 0.0019 (z - 0.4)^2 m.
+void addAxialNoise(cv::Mat& depth, std::mt19937& rng) {
+  std::normal_distribution<float> normal;
+  for (int v = 0; v < depth.rows; ++v) {
+    float* row = depth.ptr<float>(v);
+    for (int u = 0; u < depth.cols; ++u) {
+      if (!std::isfinite(row[u]))
+        continue;
+      const float z = row[u];
+      row[u] = z + (0.0012f + 0.0019f * (z - 0.4f) * (z - 0.4f)) * normal(rng);
+    }
+  }
+}
+
 double holeFraction(const cv::Mat& depth) {
   int holes = 0;
   for (int v = 0; v < depth.rows; ++v)
@@ -246,6 +267,12 @@ std::vector<Trial> runFrame(const std::string& png, int frame_index, const Optio
       t.truth = knownMotion(o.seed, frame_index, step, m);
       qs::RgbdFrame current = keyframe;
       current.depth_m = qs::warpDepthImage(keyframe.depth_m, keyframe.intrinsics, t.truth);
+      if (o.depth_noise) {
+        std::seed_seq noise_seed{o.seed, static_cast<unsigned>(frame_index),
+                                 static_cast<unsigned>(step), static_cast<unsigned>(m), 7u};
+        std::mt19937 rng(noise_seed);
+        addAxialNoise(current.depth_m, rng);
+      }
       current.stamp = keyframe.stamp + kFrameInterval;
       t.hole_fraction = holeFraction(current.depth_m);
 
@@ -330,7 +357,8 @@ int main(int argc, char** argv) {
   char line[512];
   md << "Real depth frames warped by known motions (" << o.frames.size() << " frames x "
      << o.motions_per_step << " motions per step, seed " << o.seed << ", quadric guess "
-     << (o.guess ? "on" : "off") << ")\n\n"
+     << (o.guess ? "on" : "off") << ", " << (o.depth_noise ? "fresh axial noise" : "no new noise")
+     << " on the warped frame)\n\n"
      << "| step | trials | recovered | ok but wrong | degenerate | lost | median error cm | "
         "median error deg | p95 error cm | holes | started from guess | odometry ms (median) |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -356,7 +384,7 @@ int main(int argc, char** argv) {
     }
     auto share = [n](int k) { return 100.0 * k / std::max(n, 1); };
     std::snprintf(line, sizeof(line),
-                  "| %d cm, %d deg | %d | %.0f%% | %.0f%% | %.0f%% | %.0f%% | %.1f | %.1f | %.1f | "
+                  "| %d cm, %d deg | %d | %.0f%% | %.0f%% | %.0f%% | %.0f%% | %.2f | %.2f | %.1f | "
                   "%.0f%% | %.0f%% | %.1f |\n",
                   step, step, n, share(rec), share(wrong), share(degenerate), share(lost),
                   100 * median(te), median(re), 100 * percentile(te, 0.95), 100 * median(holes),
