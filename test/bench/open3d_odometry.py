@@ -217,19 +217,28 @@ class Odometry:
         if self.method == "t_point_to_plane":
             T = o3d.core.Tensor(init)
             fitness = 0.0
-            for level in reversed(range(len(self.level_K))):  # coarse to fine
-                source_vertex = source[level][0]
-                target_vertex, target_normal = target[level]
-                for _ in range(self.iterations[level]):
-                    step = o3d.t.pipelines.odometry.compute_odometry_result_point_to_plane(
-                        source_vertex.as_tensor(), target_vertex.as_tensor(),
-                        target_normal.as_tensor(), self.level_K[level], T, 0.07, 0.05)
-                    T = step.transformation.matmul(T)  # as rgbd_odometry_multi_scale does
-                    fitness = step.fitness
+            try:
+                for level in reversed(range(len(self.level_K))):  # coarse to fine
+                    source_vertex = source[level][0]
+                    target_vertex, target_normal = target[level]
+                    for _ in range(self.iterations[level]):
+                        step = o3d.t.pipelines.odometry.compute_odometry_result_point_to_plane(
+                            source_vertex.as_tensor(), target_vertex.as_tensor(),
+                            target_normal.as_tensor(), self.level_K[level], T, 0.07, 0.05)
+                        T = step.transformation.matmul(T)  # as rgbd_odometry_multi_scale does
+                        fitness = step.fitness
+            except RuntimeError:
+                # "Singular 6x6 linear system detected, tracking failed": no correspondences left
+                # (large steps between sub-sampled frames); a failed frame, as Open3D reports it.
+                return False, init
             T = T.numpy()
             return bool(np.all(np.isfinite(T)) and fitness > 0), T
-        result = o3d.pipelines.registration.registration_icp(
-            source, target, 2.0 * self.voxel, init, self.estimation, self.criteria)
+        try:
+            result = o3d.pipelines.registration.registration_icp(
+                source, target, 2.0 * self.voxel, init, self.estimation, self.criteria)
+        except RuntimeError:
+            # An empty target (a frame without valid depth within depth_max) has no normals.
+            return False, init
         return bool(result.fitness > 0.3), np.asarray(result.transformation)
 
 
