@@ -71,7 +71,9 @@ OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_
 
 namespace {
 
-bool isLost(const PointToPlaneIcp::Result& r) { return r.status == TrackingStatus::kLost; }
+bool isLost(const PointToPlaneIcp::Result& r) {
+  return r.status == TrackingStatus::kLost;
+}
 
 // a is the better alignment than b: not lost when b is; else more inlier correspondences (beyond
 // 2%); at counts within 2% of each other, the smaller residual.
@@ -87,7 +89,8 @@ bool betterAlignment(const PointToPlaneIcp::Result& a, const PointToPlaneIcp::Re
 
 }  // namespace
 
-bool OdometryTracker::startsElsewhere(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) const {
+bool OdometryTracker::startsElsewhere(const Eigen::Isometry3d& a,
+                                      const Eigen::Isometry3d& b) const {
   const Eigen::Isometry3d difference = a.inverse() * b;
   return difference.translation().norm() >= params_.guess_min_translation ||
          pose_math::rotationAngle(difference) >= params_.guess_min_rotation;
@@ -120,9 +123,9 @@ PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
   return best;
 }
 
-OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
-                                               const CameraIntrinsics& intrinsics, double stamp,
-                                               const std::vector<QuadricMeasurement>* observations) {
+OdometryTracker::Result OdometryTracker::track(
+    const Cloud& cloud, const CameraIntrinsics& intrinsics, double stamp,
+    const std::vector<QuadricMeasurement>* observations) {
   std::string problem;
   if (organizedCloudDecimation(intrinsics, static_cast<int>(cloud.width),
                                static_cast<int>(cloud.height), &problem) == 0)
@@ -159,9 +162,8 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   }
   const Eigen::Isometry3d T_keyframe_odom = T_odom_keyframe_.inverse();
   Result out;
-  PointToPlaneIcp::Result icp = alignFromBestStart(cloud, T_keyframe_odom * prediction,
-                                                   T_keyframe_odom * T_odom_camera_, observations,
-                                                   out);
+  PointToPlaneIcp::Result icp = alignFromBestStart(
+      cloud, T_keyframe_odom * prediction, T_keyframe_odom * T_odom_camera_, observations, out);
 
   const Eigen::Isometry3d previous = T_odom_camera_;
   bool new_keyframe = false;

@@ -62,10 +62,10 @@ class OdometryTracker {
     // R_true = exp(r^) R, both in the odom frame (nav_msgs/Odometry pose covariance order).
     Matrix6 covariance = Matrix6::Zero();
     TrackingStatus status = TrackingStatus::kLost;
-    bool new_keyframe = false;    // this frame became the keyframe
-    int consecutive_lost = 0;     // lost frames in a row, this one included
-    PointToPlaneIcp::Result icp;  // details of the alignment (empty for the first frame)
-    QuadricMotionGuess guess;     // the surfaces' motion guess (found = false when not made)
+    bool new_keyframe = false;        // this frame became the keyframe
+    int consecutive_lost = 0;         // lost frames in a row, this one included
+    PointToPlaneIcp::Result icp;      // details of the alignment (empty for the first frame)
+    QuadricMotionGuess guess;         // the surfaces' motion guess (found = false when not made)
     bool started_from_guess = false;  // ICP's result came from the guess, not the prior
     bool started_from_last_pose = false;  // ... from the last pose (zero motion), not the prior
   };

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "quadric_slam/types/camera_intrinsics.h"
 #include "quadric_slam/odometry/pose_math.h"
+#include "quadric_slam/types/camera_intrinsics.h"
 
 namespace quadric_slam {
 
@@ -84,13 +84,15 @@ class PointToPlaneIcp {
     // of the current points that land on a keyframe point pass the distance gate
     // (Result::overlap_near_fraction): a pose that is off by more than the gate leaves whole
     // surfaces outside it even where the views overlap. (Not the normal gate: far walls' normals
-    // are too noisy to pass it, right or wrong.) [0, 1]; 0 disables. Chosen on the real
-    // 7-Scenes kitchen: right steps (error < 3 cm) had 0.72-1.0 at full rate, every 10th and every
-    // 20th frame, the one wrong step (12 cm off) 0.62; see config/odometry.yaml.
+    // are too noisy to pass it, right or wrong: 0.6-0.7 of the points of right steps at 3-4.5 m.)
+    // Right steps (error < 3 cm / 3 deg) had at least 0.91 on the real 7-Scenes kitchen (full rate,
+    // every 10th and every 20th frame) and 0.89 on generated fr1_desk / fr1_room sequences taken at
+    // 3 and 1.5 Hz; of the wrong steps there (> 5 cm or 5 deg), 14 of 75 were below 0.7 (the rest,
+    // sliding along a plane, keep their points near it). [0, 1]; 0 disables.
     double min_overlap_inlier_fraction = 0.7;
-    // ... or when the depth-normalised RMS point-to-plane residual of the inliers exceeds this (m at
-    // 1 m depth when depth_noise_weighting). (0, 1]; 1 disables. Right steps on the kitchen and the
-    // generated fr1 sequences stayed below 0.0032.
+    // ... or when the depth-normalised RMS point-to-plane residual of the inliers exceeds this (m
+    // at 1 m depth when depth_noise_weighting). (0, 1]; 1 disables. Right steps on the kitchen and
+    // the generated fr1 sequences stayed below 0.0032.
     double max_rms_residual = 0.005;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
@@ -107,7 +109,7 @@ class PointToPlaneIcp {
     // Sampled current points that land on a keyframe point with a normal at the finest level (the
     // overlap of the two views), whether or not they pass the gates.
     int projected_points = 0;
-    int correspondences = 0;   // inliers at the finest level
+    int correspondences = 0;  // inliers at the finest level
     double inlier_fraction = 0;
     double overlap_inlier_fraction = 0;  // correspondences / projected_points
     // Share of projected_points within the distance gate (whatever their normals).

@@ -1,9 +1,9 @@
 // No runaway on far walls: a hand-held camera looks into a room's corner from 3 m, so the view is
 // mostly two walls at 3-4.5 m (Kinect v1 depth noise of several cm there, harsh model) and the
-// floor, at full rate (about 1 cm per frame). Once, frame-to-keyframe ICP from the constant-velocity
-// prior estimated 15-17 cm steps against 1.2 cm of true motion in such a view, status ok, and the
-// prior carried the error on (issue 12). Here: ok never comes with a step error above 2 cm, and
-// the trajectory stays on the truth (ATE bound).
+// floor, at full rate (about 1 cm per frame). Once, frame-to-keyframe ICP from the
+// constant-velocity prior estimated 15-17 cm steps against 1.2 cm of true motion in such a view,
+// status ok, and the prior carried the error on (issue 12). Here: ok never comes with a step error
+// above 2 cm, and the trajectory stays on the truth (ATE bound).
 #include <gtest/gtest.h>
 
 #include <string>
@@ -71,9 +71,9 @@ TEST(TrackingFarWalls, AVelocityTheDataDoNotConfirmIsNotCarriedOn) {
     if (k != 0 && k != 14 && k != 15)
       continue;
     clouds.emplace_back();
-    normals.compute(backProject(depthViewOf(frame.depth_m), frame.intrinsics,
-                                params.back_projection),
-                    clouds.back());
+    normals.compute(
+        backProject(depthViewOf(frame.depth_m), frame.intrinsics, params.back_projection),
+        clouds.back());
     observations.push_back(
         toFrameMeasurements(segmenter.segment(clouds.back()), frame.stamp, frame.frame_id)
             .observations);
@@ -86,14 +86,14 @@ TEST(TrackingFarWalls, AVelocityTheDataDoNotConfirmIsNotCarriedOn) {
   OdometryTracker tracker(params.odometry);
   const double t0 = 100.0, dt = 1.0 / 30.0;
   tracker.track(clouds[0], intrinsics, t0, &observations[0]);
-  const OdometryTracker::Result jump = tracker.track(clouds[1], intrinsics, t0 + dt,
-                                                     &observations[1]);
+  const OdometryTracker::Result jump =
+      tracker.track(clouds[1], intrinsics, t0 + dt, &observations[1]);
   ASSERT_EQ(jump.status, TrackingStatus::kOk) << jump.icp.message;
   const Eigen::Isometry3d true_jump = truth[0].inverse() * truth[1];
   ASSERT_LT((jump.T_odom_camera.inverse() * true_jump).translation().norm(), 0.02);
   // The camera now moves about 1 cm; the prior says another step as large as the first.
-  const OdometryTracker::Result stop = tracker.track(clouds[2], intrinsics, t0 + 2 * dt,
-                                                     &observations[2]);
+  const OdometryTracker::Result stop =
+      tracker.track(clouds[2], intrinsics, t0 + 2 * dt, &observations[2]);
   const Eigen::Isometry3d true_stop = truth[0].inverse() * truth[2];
   const double error = (stop.T_odom_camera.inverse() * true_stop).translation().norm();
   EXPECT_EQ(stop.status, TrackingStatus::kOk) << stop.icp.message;

@@ -6,8 +6,8 @@
 
 #include <string>
 
-#include "quadric_slam/io/tum_folder_reader.h"
 #include "../test_data.h"
+#include "quadric_slam/io/tum_folder_reader.h"
 #include "tracking_run.h"
 
 namespace quadric_slam {

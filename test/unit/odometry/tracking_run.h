@@ -32,7 +32,8 @@ struct TrackedFrame {
   bool new_keyframe = false;
   bool from_guess = false, from_last_pose = false;
   int candidate_points = 0, projected_points = 0, correspondences = 0;
-  double inlier_fraction = 0, overlap_inlier_fraction = 0, overlap_near_fraction = 0, rms_residual = 0, eigenvalue_ratio = 0;
+  double inlier_fraction = 0, overlap_inlier_fraction = 0, overlap_near_fraction = 0,
+         rms_residual = 0, eigenvalue_ratio = 0;
   // The step from the last frame whose pose the tracker stands by (not lost, or a new keyframe)
   // to this one: true size and the estimate's error against the truth.
   double true_step_m = 0, true_step_deg = 0;
@@ -71,15 +72,16 @@ inline void writeTrackingCsv(const TrackingRun& run, const std::string& name) {
     return;
   std::ofstream csv(std::string(dir) + "/" + name + ".csv");
   csv << "stamp,status,new_keyframe,from_guess,from_last_pose,candidate_points,projected_points,"
-         "correspondences,inlier_fraction,overlap_inlier_fraction,overlap_near_fraction,rms_residual,eigenvalue_ratio,"
+         "correspondences,inlier_fraction,overlap_inlier_fraction,overlap_near_fraction,rms_"
+         "residual,eigenvalue_ratio,"
          "true_step_m,true_step_deg,step_error_m,step_error_deg\n";
   for (const TrackedFrame& f : run.frames) {
     csv << std::fixed << f.stamp << ',' << toString(f.status) << ',' << f.new_keyframe << ','
         << f.from_guess << ',' << f.from_last_pose << ',' << f.candidate_points << ','
         << f.projected_points << ',' << f.correspondences << ',' << f.inlier_fraction << ','
-        << f.overlap_inlier_fraction << ',' << f.overlap_near_fraction << ',' << f.rms_residual << ',' << f.eigenvalue_ratio << ','
-        << f.true_step_m << ',' << f.true_step_deg << ',' << f.step_error_m << ','
-        << f.step_error_deg << '\n';
+        << f.overlap_inlier_fraction << ',' << f.overlap_near_fraction << ',' << f.rms_residual
+        << ',' << f.eigenvalue_ratio << ',' << f.true_step_m << ',' << f.true_step_deg << ','
+        << f.step_error_m << ',' << f.step_error_deg << '\n';
   }
 }
 
@@ -101,9 +103,8 @@ inline TrackingRun runTracker(FrameSource& source, const Trajectory& truth,
        ++index) {
     if (index % every != 0)
       continue;
-    normals.compute(backProject(depthViewOf(frame.depth_m), frame.intrinsics,
-                                params.back_projection),
-                    cloud);
+    normals.compute(
+        backProject(depthViewOf(frame.depth_m), frame.intrinsics, params.back_projection), cloud);
     const FrameMeasurements measurements =
         toFrameMeasurements(segmenter.segment(cloud), frame.stamp, frame.frame_id);
     const OdometryTracker::Result result =
@@ -122,7 +123,7 @@ inline TrackingRun runTracker(FrameSource& source, const Trajectory& truth,
     f.overlap_near_fraction = result.icp.overlap_near_fraction;
     f.rms_residual = result.icp.rms_residual;
     f.eigenvalue_ratio = result.icp.eigenvalue_ratio;
-    ++(result.status == TrackingStatus::kOk         ? run.ok
+    ++(result.status == TrackingStatus::kOk           ? run.ok
        : result.status == TrackingStatus::kDegenerate ? run.degenerate
                                                       : run.lost);
     if (tracker.initialized()) {
