@@ -69,36 +69,63 @@ OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_
   return out;
 }
 
-PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
-    const Cloud& cloud, const Eigen::Isometry3d& T_keyframe_prior,
-    const std::vector<QuadricMeasurement>* observations, Result& out) {
-  PointToPlaneIcp::Result from_prior = icp_.align(cloud, T_keyframe_prior);
-  if (!params_.quadric_motion_guess || !observations || keyframe_observations_.empty())
-    return from_prior;
-  out.guess = guesser_.guess(keyframe_observations_, *observations, T_keyframe_prior);
-  if (!out.guess.found)
-    return from_prior;
-  const Eigen::Isometry3d difference = T_keyframe_prior.inverse() * out.guess.T_reference_current;
-  if (difference.translation().norm() < params_.guess_min_translation &&
-      pose_math::rotationAngle(difference) < params_.guess_min_rotation)
-    return from_prior;  // the prior already starts where the surfaces say
-  PointToPlaneIcp::Result from_guess = icp_.align(cloud, out.guess.T_reference_current);
-  const auto lost = [](const PointToPlaneIcp::Result& r) { return r.status == TrackingStatus::kLost; };
-  bool guess_better = false;
-  if (lost(from_prior) != lost(from_guess)) {
-    guess_better = lost(from_prior);
-  } else if (from_guess.correspondences > 1.02 * from_prior.correspondences) {
-    guess_better = true;
-  } else if (from_prior.correspondences <= 1.02 * from_guess.correspondences) {
-    guess_better = from_guess.rms_residual < from_prior.rms_residual;
-  }
-  out.started_from_guess = guess_better;
-  return guess_better ? from_guess : from_prior;
+namespace {
+
+bool isLost(const PointToPlaneIcp::Result& r) {
+  return r.status == TrackingStatus::kLost;
 }
 
-OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
-                                               const CameraIntrinsics& intrinsics, double stamp,
-                                               const std::vector<QuadricMeasurement>* observations) {
+// a is the better alignment than b: not lost when b is; else more inlier correspondences (beyond
+// 2%); at counts within 2% of each other, the smaller residual.
+bool betterAlignment(const PointToPlaneIcp::Result& a, const PointToPlaneIcp::Result& b) {
+  if (isLost(a) != isLost(b))
+    return isLost(b);
+  if (a.correspondences > 1.02 * b.correspondences)
+    return true;
+  if (b.correspondences > 1.02 * a.correspondences)
+    return false;
+  return a.rms_residual < b.rms_residual;
+}
+
+}  // namespace
+
+bool OdometryTracker::startsElsewhere(const Eigen::Isometry3d& a,
+                                      const Eigen::Isometry3d& b) const {
+  const Eigen::Isometry3d difference = a.inverse() * b;
+  return difference.translation().norm() >= params_.guess_min_translation ||
+         pose_math::rotationAngle(difference) >= params_.guess_min_rotation;
+}
+
+PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
+    const Cloud& cloud, const Eigen::Isometry3d& T_keyframe_prior,
+    const Eigen::Isometry3d& T_keyframe_last, const std::vector<QuadricMeasurement>* observations,
+    Result& out) {
+  PointToPlaneIcp::Result best = icp_.align(cloud, T_keyframe_prior);
+  if (params_.zero_motion_start && startsElsewhere(T_keyframe_prior, T_keyframe_last)) {
+    PointToPlaneIcp::Result from_last = icp_.align(cloud, T_keyframe_last);
+    // At a tie the last pose wins: the velocity was not confirmed.
+    if (!betterAlignment(best, from_last)) {
+      best = std::move(from_last);
+      out.started_from_last_pose = true;
+    }
+  }
+  if (!params_.quadric_motion_guess || !observations || keyframe_observations_.empty())
+    return best;
+  out.guess = guesser_.guess(keyframe_observations_, *observations, T_keyframe_prior);
+  if (!out.guess.found || !startsElsewhere(T_keyframe_prior, out.guess.T_reference_current))
+    return best;  // the prior already starts where the surfaces say
+  PointToPlaneIcp::Result from_guess = icp_.align(cloud, out.guess.T_reference_current);
+  if (betterAlignment(from_guess, best)) {
+    best = std::move(from_guess);
+    out.started_from_guess = true;
+    out.started_from_last_pose = false;
+  }
+  return best;
+}
+
+OdometryTracker::Result OdometryTracker::track(
+    const Cloud& cloud, const CameraIntrinsics& intrinsics, double stamp,
+    const std::vector<QuadricMeasurement>* observations) {
   std::string problem;
   if (organizedCloudDecimation(intrinsics, static_cast<int>(cloud.width),
                                static_cast<int>(cloud.height), &problem) == 0)
@@ -135,8 +162,8 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   }
   const Eigen::Isometry3d T_keyframe_odom = T_odom_keyframe_.inverse();
   Result out;
-  PointToPlaneIcp::Result icp =
-      alignFromBestStart(cloud, T_keyframe_odom * prediction, observations, out);
+  PointToPlaneIcp::Result icp = alignFromBestStart(
+      cloud, T_keyframe_odom * prediction, T_keyframe_odom * T_odom_camera_, observations, out);
 
   const Eigen::Isometry3d previous = T_odom_camera_;
   bool new_keyframe = false;
@@ -156,7 +183,11 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     //                                     = exp(a + Ad(T_odom_kf) b) T_odom_cur.
     const Matrix6 ad = pose_math::adjoint(T_odom_keyframe_);
     covariance_ = keyframe_covariance_ + ad * icp.covariance * ad.transpose();
-    last_motion_ = pose_math::orthonormalized(previous.inverse() * T_odom_camera_);
+    // Only a step constrained in all six directions and accepted by the data sets the velocity;
+    // along a degenerate direction the motion is the prior's, which must not feed itself.
+    last_motion_ = icp.status == TrackingStatus::kOk
+                       ? pose_math::orthonormalized(previous.inverse() * T_odom_camera_)
+                       : Eigen::Isometry3d::Identity();
     const Eigen::Isometry3d& from_keyframe = icp.T_reference_current;
     if (from_keyframe.translation().norm() > params_.keyframe_translation ||
         pose_math::rotationAngle(from_keyframe) > params_.keyframe_rotation ||
@@ -171,6 +202,7 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   result.icp = std::move(icp);
   result.guess = std::move(out.guess);
   result.started_from_guess = out.started_from_guess;
+  result.started_from_last_pose = out.started_from_last_pose;
   return result;
 }
 

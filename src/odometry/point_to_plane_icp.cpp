@@ -67,6 +67,8 @@ void PointToPlaneIcp::Params::validate() const {
           "max_correspondence_distance", "(0, 10] m", max_correspondence_distance);
   require(coarse_distance_factor >= 1 && coarse_distance_factor <= 10, "coarse_distance_factor",
           "[1, 10]", coarse_distance_factor);
+  require(gate_growth_depth > 0 && gate_growth_depth <= 100, "gate_growth_depth", "(0, 100] m",
+          gate_growth_depth);
   require(max_normal_angle > 0 && max_normal_angle <= M_PI, "max_normal_angle", "(0, pi] rad",
           max_normal_angle);
   require(huber_delta > 0 && huber_delta <= 1, "huber_delta", "(0, 1] m", huber_delta);
@@ -84,6 +86,10 @@ void PointToPlaneIcp::Params::validate() const {
           "max_translation_from_guess", "(0, inf) m", max_translation_from_guess);
   require(max_rotation_from_guess > 0 && max_rotation_from_guess <= M_PI, "max_rotation_from_guess",
           "(0, pi] rad", max_rotation_from_guess);
+  require(min_overlap_inlier_fraction >= 0 && min_overlap_inlier_fraction <= 1,
+          "min_overlap_inlier_fraction", "[0, 1]", min_overlap_inlier_fraction);
+  require(max_rms_residual > 0 && max_rms_residual <= 1, "max_rms_residual", "(0, 1] m",
+          max_rms_residual);
 }
 
 PointToPlaneIcp::PointToPlaneIcp(const Params& params) : params_(params) {
@@ -178,11 +184,15 @@ void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance
   eq.b.setZero();
   eq.weighted_sq = 0;
   eq.count = 0;
+  eq.projected = 0;
+  eq.near = 0;
   const Eigen::Matrix3f R = T.linear().cast<float>();
   const Eigen::Vector3f t = T.translation().cast<float>();
   const int w = ref_w_, h = ref_h_;
   const float w_f = static_cast<float>(w), h_f = static_cast<float>(h);
   const float max_sq = static_cast<float>(max_distance * max_distance);
+  const float inv_growth_sq =
+      static_cast<float>(1.0 / (params_.gate_growth_depth * params_.gate_growth_depth));
   const float min_cos = static_cast<float>(cos_max_normal_angle_);
   const double huber = params_.huber_delta;
   const bool noise_weighting = params_.depth_noise_weighting;
@@ -203,11 +213,15 @@ void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance
     const RefPoint& ref = reference_[static_cast<std::size_t>(row) * w + col];
     if (!(ref.z == ref.z))  // NaN: no point or no normal there
       continue;
+    ++eq.projected;
     const Eigen::Vector3f q(ref.x, ref.y, ref.z);
     const Eigen::Vector3f n(ref.nx, ref.ny, ref.nz);
     const Eigen::Vector3f diff = p - q;
-    if (diff.squaredNorm() > max_sq)
+    // Gate (max_distance * g)^2 with g = max(1, (z / gate_growth_depth)^2): noise grows as z^2.
+    const float growth = std::max(1.0f, ref.z * ref.z * inv_growth_sq);
+    if (diff.squaredNorm() > max_sq * growth * growth)
       continue;
+    ++eq.near;
     if (n.dot(R * s.n) < min_cos)
       continue;
     // Depth-noise normalisation: r and J divided by s = (z_ref / 1 m)^2 (sigma(z) ~ z^2).
@@ -294,6 +308,8 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
       if (level == 0) {
         finest_ok = true;
         result.correspondences = eq.count;
+        result.projected_points = eq.projected;
+        result.overlap_near_fraction = eq.projected > 0 ? double(eq.near) / eq.projected : 0.0;
         result.constrained_dof = constrained;
         result.eigenvalue_ratio = lambda(5) > 0 ? std::max(0.0, lambda(0)) / lambda(5) : 0.0;
         const double dof = std::max(1, eq.count - 6);
@@ -327,6 +343,8 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
   }
   result.inlier_fraction =
       result.candidate_points > 0 ? double(result.correspondences) / result.candidate_points : 0.0;
+  result.overlap_inlier_fraction =
+      result.projected_points > 0 ? double(result.correspondences) / result.projected_points : 0.0;
   const Eigen::Isometry3d change = T * T_reference_current_guess.inverse();
   const double moved = change.translation().norm();
   const double turned = pose_math::rotationAngle(change);
@@ -334,6 +352,18 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
       !(turned <= params_.max_rotation_from_guess) || !T.matrix().allFinite()) {
     std::ostringstream why;
     why << "implausible result: " << moved << " m and " << turned << " rad from the initial guess";
+    result.message = why.str();
+    result.covariance = Matrix6::Identity() * params_.degenerate_variance;
+    return result;
+  }
+  if (result.overlap_near_fraction < params_.min_overlap_inlier_fraction ||
+      !(result.rms_residual <= params_.max_rms_residual)) {
+    // The data say the alignment is wrong: surfaces the two views share do not meet.
+    std::ostringstream why;
+    why << "alignment rejected: " << result.overlap_near_fraction << " of "
+        << result.projected_points << " overlapping points within the distance gate (need "
+        << params_.min_overlap_inlier_fraction << "), residual RMS " << result.rms_residual
+        << " (at most " << params_.max_rms_residual << ")";
     result.message = why.str();
     result.covariance = Matrix6::Identity() * params_.degenerate_variance;
     return result;

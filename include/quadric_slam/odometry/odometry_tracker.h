@@ -44,6 +44,13 @@ class OdometryTracker {
     double guess_min_translation = 0.02;
     double guess_min_rotation = 0.035;
     QuadricMotionGuesser::Params guess;
+    // No runaway: when the constant-velocity prediction is more than guess_min_translation or
+    // guess_min_rotation from the last pose, ICP also starts from the last pose (zero motion) and
+    // the better alignment is kept, so a velocity the data do not confirm cannot carry the
+    // estimate on. The velocity itself is only kept after a step that is ok (all six directions
+    // constrained and the alignment accepted); after a degenerate or lost step the prior is the
+    // last pose.
+    bool zero_motion_start = true;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -55,11 +62,12 @@ class OdometryTracker {
     // R_true = exp(r^) R, both in the odom frame (nav_msgs/Odometry pose covariance order).
     Matrix6 covariance = Matrix6::Zero();
     TrackingStatus status = TrackingStatus::kLost;
-    bool new_keyframe = false;    // this frame became the keyframe
-    int consecutive_lost = 0;     // lost frames in a row, this one included
-    PointToPlaneIcp::Result icp;  // details of the alignment (empty for the first frame)
-    QuadricMotionGuess guess;     // the surfaces' motion guess (found = false when not made)
+    bool new_keyframe = false;        // this frame became the keyframe
+    int consecutive_lost = 0;         // lost frames in a row, this one included
+    PointToPlaneIcp::Result icp;      // details of the alignment (empty for the first frame)
+    QuadricMotionGuess guess;         // the surfaces' motion guess (found = false when not made)
     bool started_from_guess = false;  // ICP's result came from the guess, not the prior
+    bool started_from_last_pose = false;  // ... from the last pose (zero motion), not the prior
   };
 
   explicit OdometryTracker(const Params& params);
@@ -83,11 +91,15 @@ class OdometryTracker {
  private:
   void setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics,
                    const std::vector<QuadricMeasurement>* observations);
-  // ICP from the prior, and from the surfaces' guess when it differs; the better of the two.
+  // ICP from the prior, from the last pose and from the surfaces' guess when they differ from the
+  // prior; the best of them.
   PointToPlaneIcp::Result alignFromBestStart(const Cloud& cloud,
                                              const Eigen::Isometry3d& T_keyframe_prior,
+                                             const Eigen::Isometry3d& T_keyframe_last,
                                              const std::vector<QuadricMeasurement>* observations,
                                              Result& out);
+  // The two starts are further apart than guess_min_translation or guess_min_rotation.
+  bool startsElsewhere(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) const;
   Result output(TrackingStatus status, bool new_keyframe) const;
 
   Params params_;

@@ -86,6 +86,10 @@ TEST(OdometryTracker, ParamsValidateNamesTheBadField) {
   rejects([](OdometryTracker::Params& p) { p.lost_frames_before_new_keyframe = 0; },
           "lost_frames_before_new_keyframe");
   rejects([](OdometryTracker::Params& p) { p.icp.min_correspondences = 1; }, "min_correspondences");
+  rejects([](OdometryTracker::Params& p) { p.icp.min_overlap_inlier_fraction = 1.5; },
+          "min_overlap_inlier_fraction");
+  rejects([](OdometryTracker::Params& p) { p.icp.max_rms_residual = 0; }, "max_rms_residual");
+  rejects([](OdometryTracker::Params& p) { p.icp.gate_growth_depth = 0; }, "gate_growth_depth");
   OdometryTracker::Params bad;
   bad.icp.pyramid_levels = 9;
   EXPECT_THROW(OdometryTracker tracker(bad), std::invalid_argument);
