@@ -35,10 +35,14 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "degenerate_variance", icp.degenerate_variance, log);
   readParam(reader, "max_translation_from_guess", icp.max_translation_from_guess, log);
   readParam(reader, "max_rotation_from_guess", icp.max_rotation_from_guess, log);
+  readParam(reader, "min_overlap_inlier_fraction", icp.min_overlap_inlier_fraction, log);
+  readParam(reader, "max_rms_residual", icp.max_rms_residual, log);
+  readParam(reader, "gate_growth_depth", icp.gate_growth_depth, log);
   readParam(reader, "keyframe_translation", params.keyframe_translation, log);
   readParam(reader, "keyframe_rotation", params.keyframe_rotation, log);
   readParam(reader, "keyframe_min_overlap", params.keyframe_min_overlap, log);
   readParam(reader, "constant_velocity", params.constant_velocity, log);
+  readParam(reader, "zero_motion_start", params.zero_motion_start, log);
   readParam(reader, "lost_frames_before_new_keyframe", params.lost_frames_before_new_keyframe, log);
   readParam(reader, "quadric_motion_guess", params.quadric_motion_guess, log);
   readParam(reader, "guess_min_translation", params.guess_min_translation, log);
