@@ -76,19 +76,30 @@ Trajectory readTumTrajectory(const std::string& path) {
   return parseTumTrajectory(in, path);
 }
 
-void writeTumTrajectory(const Trajectory& trajectory, std::ostream& out,
-                        const std::string& comment) {
+namespace {
+
+void writeTumHeader(std::ostream& out, const std::string& comment) {
   if (!comment.empty())
     out << "# " << comment << "\n";
   out << "# timestamp tx ty tz qx qy qz qw\n";
+}
+
+void writeTumPose(std::ostream& out, const StampedPose& pose) {
   char buffer[256];
-  for (const StampedPose& pose : trajectory) {
-    const Eigen::Vector3d t = pose.T_world_sensor.translation();
-    const Eigen::Quaterniond q(pose.T_world_sensor.rotation());
-    std::snprintf(buffer, sizeof(buffer), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", pose.stamp,
-                  t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-    out << buffer;
-  }
+  const Eigen::Vector3d t = pose.T_world_sensor.translation();
+  const Eigen::Quaterniond q(pose.T_world_sensor.rotation());
+  std::snprintf(buffer, sizeof(buffer), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", pose.stamp,
+                t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  out << buffer;
+}
+
+}  // namespace
+
+void writeTumTrajectory(const Trajectory& trajectory, std::ostream& out,
+                        const std::string& comment) {
+  writeTumHeader(out, comment);
+  for (const StampedPose& pose : trajectory)
+    writeTumPose(out, pose);
 }
 
 void writeTumTrajectory(const Trajectory& trajectory, const std::string& path,
@@ -100,6 +111,21 @@ void writeTumTrajectory(const Trajectory& trajectory, const std::string& path,
   out.flush();
   if (!out)
     throw std::runtime_error(path + ": write failed");
+}
+
+TumTrajectoryWriter::TumTrajectoryWriter(const std::string& path, const std::string& comment)
+    : path_(path), out_(path) {
+  if (!out_)
+    throw std::runtime_error(path + ": cannot open for writing");
+  writeTumHeader(out_, comment);
+  out_.flush();
+}
+
+void TumTrajectoryWriter::append(const StampedPose& pose) {
+  writeTumPose(out_, pose);
+  out_.flush();
+  if (!out_)
+    throw std::runtime_error(path_ + ": write failed");
 }
 
 }  // namespace quadric_slam

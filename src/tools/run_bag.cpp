@@ -222,7 +222,14 @@ int main(int argc, char** argv) {
     }
 
     qs::StageTimer read_timer;
-    qs::Trajectory odom_trajectory, map_trajectory;
+    // Written as the frames come (not kept in memory: flat memory over long runs).
+    qs::TumTrajectoryWriter odom_trajectory(
+        o.out_dir + "/trajectory_odom.txt",
+        "quadric_slam run_bag: camera optical frame in the odom frame");
+    qs::TumTrajectoryWriter slam_trajectory(
+        o.out_dir + "/trajectory.txt",
+        o.odometry_only ? "quadric_slam run_bag: camera optical frame in the odom frame"
+                        : "quadric_slam run_bag: camera optical frame in the map frame");
     int status_counts[3] = {0, 0, 0};
     std::size_t frames_recovering = 0;  // the mapper localised only (after a loss of tracking)
     std::map<std::string, std::size_t> observations_per_class;
@@ -245,10 +252,13 @@ int main(int argc, char** argv) {
         ++observations_per_class[qs::toString(m.quadric_camera.quadricClass())];
       ++status_counts[static_cast<int>(result.odometry.status)];
       frames_recovering += result.recovering ? 1 : 0;
-      if (result.tracking)
-        odom_trajectory.push_back({frame.stamp, result.odometry.T_odom_camera});
+      if (result.tracking) {
+        odom_trajectory.append({frame.stamp, result.odometry.T_odom_camera});
+        if (o.odometry_only)
+          slam_trajectory.append({frame.stamp, result.odometry.T_odom_camera});
+      }
       if (result.mapped) {
-        map_trajectory.push_back({frame.stamp, result.mapping.T_map_camera});
+        slam_trajectory.append({frame.stamp, result.mapping.T_map_camera});
         keyframes += result.mapping.keyframe;
         joined += result.mapping.update.joined.size();
         merged_online += result.mapping.merges.size();
@@ -284,13 +294,6 @@ int main(int argc, char** argv) {
 
     qs::StageTimer timer = slam.timer();
     timer.merge(read_timer);
-    const qs::Trajectory& slam_trajectory = o.odometry_only ? odom_trajectory : map_trajectory;
-    qs::writeTumTrajectory(odom_trajectory, o.out_dir + "/trajectory_odom.txt",
-                           "quadric_slam run_bag: camera optical frame in the odom frame");
-    qs::writeTumTrajectory(slam_trajectory, o.out_dir + "/trajectory.txt",
-                           o.odometry_only
-                               ? "quadric_slam run_bag: camera optical frame in the odom frame"
-                               : "quadric_slam run_bag: camera optical frame in the map frame");
     std::ofstream(o.out_dir + "/timing.json") << timer.json(frames, wall_s);
 
     std::printf("frames %zu\nskipped %zu\nwall_s %.3f\nfps %.2f\n", frames, skipped, wall_s,
@@ -357,9 +360,9 @@ int main(int argc, char** argv) {
       std::printf("map %s/map.yaml\n", o.out_dir.c_str());
     }
     if (!o.gt_path.empty()) {
-      printTrajectoryErrors(o.gt_path, odom_trajectory);
+      printTrajectoryErrors(o.gt_path, qs::readTumTrajectory(odom_trajectory.path()));
       if (!o.odometry_only)
-        printTrajectoryErrors(o.gt_path, map_trajectory, "map_");
+        printTrajectoryErrors(o.gt_path, qs::readTumTrajectory(slam_trajectory.path()), "map_");
     }
   } catch (const std::exception& e) {
     std::cerr << "\nrun_bag: " << e.what() << "\n";

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <iosfwd>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -30,5 +31,19 @@ void writeTumTrajectory(const Trajectory& trajectory, const std::string& path,
                         const std::string& comment = "");
 void writeTumTrajectory(const Trajectory& trajectory, std::ostream& out,
                         const std::string& comment = "");
+
+// The same file written one pose at a time, so a long run need not keep its trajectory in memory.
+// The header goes out on construction; each append() is flushed to the line. Throws
+// std::runtime_error when the file cannot be opened or written.
+class TumTrajectoryWriter {
+ public:
+  TumTrajectoryWriter(const std::string& path, const std::string& comment = "");
+  void append(const StampedPose& pose);
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::ofstream out_;
+};
 
 }  // namespace quadric_slam

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -75,4 +77,31 @@ TEST(TrajectoryIo, WriteThenReadRoundTrips) {
     EXPECT_NEAR(back[k].stamp, t[k].stamp, 1e-6);
     EXPECT_TRUE(back[k].T_world_sensor.isApprox(t[k].T_world_sensor, 1e-8)) << k;
   }
+}
+
+TEST(TrajectoryIo, PoseByPoseWriterGivesTheSameFile) {
+  Trajectory t;
+  for (int k = 0; k < 4; ++k) {
+    StampedPose p;
+    p.stamp = 100.0 + 0.1 * k;
+    p.T_world_sensor.linear() =
+        Eigen::AngleAxisd(0.3 * k, Eigen::Vector3d(0, 1, 1).normalized()).toRotationMatrix();
+    p.T_world_sensor.translation() = Eigen::Vector3d(k, -0.5 * k, 2.0);
+    t.push_back(p);
+  }
+  const std::string path = ::testing::TempDir() + "/trajectory_io_writer.txt";
+  {
+    quadric_slam::TumTrajectoryWriter writer(path, "written pose by pose");
+    for (const StampedPose& p : t)
+      writer.append(p);
+    // Each pose is on disk as soon as it is appended (a long run can be watched or cut short).
+    EXPECT_EQ(quadric_slam::readTumTrajectory(path).size(), t.size());
+  }
+  std::ifstream in(path);
+  const std::string streamed((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ostringstream whole;
+  quadric_slam::writeTumTrajectory(t, whole, "written pose by pose");
+  EXPECT_EQ(streamed, whole.str());
+  std::remove(path.c_str());
+  EXPECT_THROW(quadric_slam::TumTrajectoryWriter("/nonexistent-dir/x.txt"), std::runtime_error);
 }
