@@ -123,7 +123,10 @@ def live_section(out):
         rows = [r for r in diagnostics if r["name"] == name and r["median_ms"]]
         pts = [{"t": float(r["wall_s"]), "median": float(r["median_ms"]),
                 "processed": float(r["frames_processed"] or 0),
-                "landmarks": float(r["landmarks"]) if r["landmarks"] else None} for r in rows]
+                "landmarks": float(r["landmarks"]) if r["landmarks"] else None,
+                # (a column added later: absent in older files)
+                "points": float(r["reconstruction_points"]) if r.get("reconstruction_points")
+                else None} for r in rows]
         if not pts:
             continue
         warm_pts = after_warm_up(pts)
@@ -135,6 +138,11 @@ def live_section(out):
             lines.append(curve_line(f"{short}: landmarks", "count",
                                     [p["t"] for p in with_landmarks],
                                     [p["landmarks"] for p in with_landmarks]))
+        with_points = [p for p in warm_pts if p["points"] is not None]
+        if with_points:
+            lines.append(curve_line(f"{short}: reconstruction points", "count",
+                                    [p["t"] for p in with_points],
+                                    [p["points"] for p in with_points]))
         lines.append(f"| {short}: frames processed | count | - | {pts[-1]['processed']:.0f} | "
                      f"{3600 * pts[-1]['processed'] / max(pts[-1]['t'], 1):.0f} per hour | - | - |")
         path = os.path.join(out, "live", "series_" + "".join(c if c.isalnum() else "_" for c in short)

@@ -731,6 +731,7 @@ class MappingNodelet : public nodelet::Nodelet {
     RecentDurations processing_times{300};  // of processed frames, the latest 300
     std::map<std::string, int> landmarks_per_class;
     int landmarks = 0, candidates = 0;
+    long reconstruction_points = 0;  // what a long run grows until the surfaces are covered
     std::string observation_frame, camera_frame;  // of the latest frame (observations, odom child)
     std::string mode = "mapping";                 // or "localisation only"
     std::string loaded_from;                      // the loaded map file, if any
@@ -751,6 +752,7 @@ class MappingNodelet : public nodelet::Nodelet {
     stats_.landmarks_per_class = per_class;
     stats_.landmarks = static_cast<int>(mapper_->map().landmarks().size());
     stats_.candidates = static_cast<int>(mapper_->map().candidates().size());
+    stats_.reconstruction_points = static_cast<long>(reconstruction_->size());
     stats_.mode = recovery_.recovering() && !user_localization_only_
                       ? "relocalising after a loss of tracking (localisation only)"
                   : mapper_->localizationOnly() ? "localisation only"
@@ -797,6 +799,7 @@ class MappingNodelet : public nodelet::Nodelet {
     status.add("mode", s.mode);
     status.add("loaded map", s.loaded_from.empty() ? std::string("none") : s.loaded_from);
     status.add("landmarks", s.landmarks);
+    status.add("reconstruction points", s.reconstruction_points);
     for (const auto& [name, count] : s.landmarks_per_class)
       status.add("landmarks: " + name, count);
     status.add("candidates", s.candidates);
