@@ -7,7 +7,6 @@
 // again (time going backwards), and bad input that must be dropped without harm.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/Path.h>
 #include <quadric_slam/LoadMap.h>
@@ -38,7 +37,7 @@
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/markers.h"
 #include "quadric_slam/sim/surfaces.h"
-#include "synthetic_bag.h"
+#include "desk_bag_test.h"
 
 namespace qs = quadric_slam;
 namespace fs = std::filesystem;
@@ -58,28 +57,9 @@ qs::MapFile toMapFile(const quadric_slam::QuadricMap& map) {
   return qs::mapFileFromLandmarks(landmarks, map.header.frame_id);
 }
 
-class MappingTest : public ::testing::Test {
+class MappingTest : public qs::test::DeskBagTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(testing::TempDir()) / ("mapping_test_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    bag_path_ = (dir_ / "desk.bag").string();
-    const qs::test::SyntheticBag bag = qs::test::writeDeskBag(bag_path_, kRate, kSeconds, 2);
-    scene_ = bag.scene;
-    truth_ = bag.truth;
-    qs::test::BagDepthFrames frames = qs::test::readBagDepthFrames(bag_path_);
-    info_ = frames.info;
-    depths_ = std::move(frames.depths);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path dir_;
-  std::string bag_path_;
-  qs::Scene scene_;
-  qs::Trajectory truth_;
-  sensor_msgs::CameraInfoConstPtr info_;
-  std::vector<sensor_msgs::ImageConstPtr> depths_;
+  MappingTest() : DeskBagTest("mapping_test", kRate, kSeconds, 2) {}
 };
 
 TEST_F(MappingTest, MapsTheDeskSavesLoadsAndLocalises) {

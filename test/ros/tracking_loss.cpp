@@ -16,12 +16,10 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/image_encodings.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <filesystem>
 #include <map>
 #include <string>
 
@@ -33,10 +31,9 @@
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/odometry_status.h"
 #include "quadric_slam/sim/surfaces.h"
-#include "synthetic_bag.h"
+#include "desk_bag_test.h"
 
 namespace qs = quadric_slam;
-namespace fs = std::filesystem;
 using qs::test::spinUntil;
 
 namespace {
@@ -88,27 +85,9 @@ long diagnosticValue(const diagnostic_msgs::DiagnosticStatus& status, const std:
   return -1;
 }
 
-class TrackingLossTest : public ::testing::Test {
+class TrackingLossTest : public qs::test::DeskBagTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(testing::TempDir()) / ("tracking_loss_test_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    const std::string bag_path = (dir_ / "desk.bag").string();
-    const qs::test::SyntheticBag bag = qs::test::writeDeskBag(bag_path, kRate, kSeconds, 11);
-    scene_ = bag.scene;
-    truth_ = bag.truth;
-    qs::test::BagDepthFrames frames = qs::test::readBagDepthFrames(bag_path);
-    info_ = frames.info;
-    depths_ = std::move(frames.depths);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path dir_;
-  qs::Scene scene_;
-  qs::Trajectory truth_;
-  sensor_msgs::CameraInfoConstPtr info_;
-  std::vector<sensor_msgs::ImageConstPtr> depths_;
+  TrackingLossTest() : DeskBagTest("tracking_loss_test", kRate, kSeconds, 11) {}
 };
 
 TEST_F(TrackingLossTest, CoveredLensSkippedSecondsAndBlankWallLeaveNoGarbage) {
