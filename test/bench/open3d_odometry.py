@@ -48,6 +48,8 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 import open3d as o3d  # noqa: E402
 
+from tum_trajectory import read_tum_trajectory  # noqa: E402
+
 METHODS = ("legacy_hybrid", "t_point_to_plane", "icp_point_to_plane")
 
 
@@ -62,33 +64,6 @@ def read_list(path):
             parts = line.split()
             rows.append((float(parts[0]), parts[1]))
     return rows
-
-
-def read_groundtruth(path):
-    """TUM trajectory -> [(stamp, 4x4 T_W_C)]."""
-    rows = []
-    with open(path) as f:
-        for line in f:
-            line = line.strip()
-            if not line or line.startswith("#"):
-                continue
-            v = [float(x) for x in line.split()]
-            rows.append((v[0], pose_from_tum(v[1:8])))
-    return rows
-
-
-def pose_from_tum(v):
-    tx, ty, tz, qx, qy, qz, qw = v
-    n = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
-    qx, qy, qz, qw = qx / n, qy / n, qz / n, qw / n
-    T = np.eye(4)
-    T[:3, :3] = [
-        [1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
-        [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
-        [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)],
-    ]
-    T[:3, 3] = [tx, ty, tz]
-    return T
 
 
 def quaternion_from_rotation(R):
@@ -263,7 +238,7 @@ def check_direction(odo, frames, args):
     """Known motion: frame N (source) aligned onto frame 0 (target) from the identity must give the
     ground truth's T_0_N = T_W_0^-1 T_W_N (points of N into 0), not its inverse. Returns 0 when it
     does."""
-    gt = read_groundtruth(os.path.join(args.seq, "groundtruth.txt"))
+    gt = read_tum_trajectory(os.path.join(args.seq, "groundtruth.txt"))
     gt_stamps = np.array([s for s, _ in gt])
     i0 = int(np.argmin(np.abs(gt_stamps - frames[0][0])))
     # The first frame N <= check_direction that has moved 2 cm or turned 2 degrees: big enough to

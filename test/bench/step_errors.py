@@ -15,31 +15,7 @@ import sys
 
 import numpy as np
 
-
-def read_trajectory(path):
-    rows = []
-    with open(path) as f:
-        for line in f:
-            line = line.strip()
-            if not line or line.startswith("#"):
-                continue
-            v = [float(x) for x in line.split()]
-            rows.append((v[0], pose(v[1:8])))
-    return rows
-
-
-def pose(v):
-    tx, ty, tz, qx, qy, qz, qw = v
-    n = math.sqrt(qx * qx + qy * qy + qz * qz + qw * qw)
-    qx, qy, qz, qw = qx / n, qy / n, qz / n, qw / n
-    T = np.eye(4)
-    T[:3, :3] = [
-        [1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
-        [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
-        [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)],
-    ]
-    T[:3, 3] = [tx, ty, tz]
-    return T
+from tum_trajectory import read_tum_trajectory
 
 
 def angle_deg(R):
@@ -54,8 +30,8 @@ def main():
     p.add_argument("--max-translation", type=float, default=0.05)
     p.add_argument("--max-rotation", type=float, default=5.0)
     a = p.parse_args()
-    gt = read_trajectory(a.gt)
-    est = read_trajectory(a.est)
+    gt = read_tum_trajectory(a.gt)
+    est = read_tum_trajectory(a.est)
     if not gt or len(est) < 2:
         sys.exit("step_errors: need a ground truth and at least two estimated poses")
     gt_stamps = np.array([s for s, _ in gt])
