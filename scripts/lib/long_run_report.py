@@ -63,7 +63,9 @@ def offline_section(out):
              "ms": float(r["ms_per_frame"]), "landmarks": int(r["landmarks"]),
              # (columns added later: absent in older files)
              "candidates": int(r.get("candidates") or 0),
-             "points": int(r.get("reconstruction_points") or 0)} for r in rows]
+             "points": int(r.get("reconstruction_points") or 0),
+             "heap": float(r["heap_in_use_mb"]) if r.get("heap_in_use_mb") else None}
+            for r in rows]
     warm = after_warm_up(data)
     xs = [r["t"] for r in warm]
     lines = ["## Offline (run_bag, frames rendered as needed)",
@@ -71,6 +73,8 @@ def offline_section(out):
              f"samples every 50 frames: {len(data)}; warm-up dropped: first 10% of the run.", "",
              TABLE_HEAD,
              curve_line("resident memory", "MB", xs, [r["rss"] for r in warm]),
+             *([curve_line("heap in use (resident less what the allocator holds free)", "MB", xs,
+                           [r["heap"] for r in warm])] if warm[0]["heap"] is not None else []),
              curve_line("time per frame (render + pipeline)", "ms", xs, [r["ms"] for r in warm]),
              curve_line("landmarks", "count", xs, [r["landmarks"] for r in warm]),
              curve_line("candidates (surfaces seen, not yet landmarks)", "count", xs,
@@ -88,6 +92,8 @@ def offline_section(out):
               ("points", 8, "reconstruction points")]
     if "reconstruction_points" not in rows[0]:
         panels = panels[:3]
+    if "heap_in_use_mb" in rows[0]:
+        panels.insert(1, ("heap in use (MB)", 9, "resident less what the allocator holds free"))
     plots = "\n".join(f"set ylabel '{label}'\n"
                       f"plot '{csv_path}' every ::1 using ($3/60):{column} with lines lw 2 "
                       f"title '{title}'" for label, column, title in panels)
@@ -126,7 +132,9 @@ def live_section(out):
                 "landmarks": float(r["landmarks"]) if r["landmarks"] else None,
                 # (a column added later: absent in older files)
                 "points": float(r["reconstruction_points"]) if r.get("reconstruction_points")
-                else None} for r in rows]
+                else None,
+                "heap": float(r["heap_in_use_mb"]) if r.get("heap_in_use_mb") else None}
+               for r in rows]
         if not pts:
             continue
         warm_pts = after_warm_up(pts)
@@ -138,6 +146,16 @@ def live_section(out):
             lines.append(curve_line(f"{short}: landmarks", "count",
                                     [p["t"] for p in with_landmarks],
                                     [p["landmarks"] for p in with_landmarks]))
+        with_heap = [p for p in warm_pts if p["heap"] is not None]
+        if with_heap:
+            lines.append(curve_line("manager heap in use (resident less what the allocator "
+                                    "holds free)", "MB", [p["t"] for p in with_heap],
+                                    [p["heap"] for p in with_heap]))
+            heap_series = os.path.join(out, "live", "series_heap.dat")
+            with open(heap_series, "w") as f:  # comma-separated: plotted beside memory.csv
+                for p in pts:
+                    if p["heap"] is not None:
+                        f.write(f"{p['t'] / 60:.3f},{p['heap']:.3f}\n")
         with_points = [p for p in warm_pts if p["points"] is not None]
         if with_points:
             lines.append(curve_line(f"{short}: reconstruction points", "count",
@@ -157,6 +175,9 @@ def live_section(out):
     medians = ", ".join(f"'{p}' using 1:2 with lines title '{n}'" for n, p in series_files)
     landmark_plots = ", ".join(f"'{p}' using 1:3 with lines lw 2 title '{n}'"
                                for n, p in series_files if "mapping" in n)
+    heap_series = os.path.join(out, "live", "series_heap.dat")
+    heap_plot = (f", '{heap_series}' using 1:2 with lines lw 2 title 'heap in use'"
+                 if os.path.exists(heap_series) else "")
     script = f"""
 set terminal png size 1000,900 noenhanced
 set output '{png}'
@@ -165,7 +186,7 @@ set multiplot layout 3,1 title 'live pipeline at real time: resources over time'
 set xlabel 'wall time (min)'
 set grid
 set ylabel 'manager RSS (MB)'
-plot '{mem_csv}' every ::1 using ($1/60):2 with lines lw 2 title 'nodelet manager'
+plot '{mem_csv}' every ::1 using ($1/60):2 with lines lw 2 title 'nodelet manager resident'{heap_plot}
 set datafile separator whitespace
 set ylabel 'processing median (ms)'
 plot {medians if medians else "0 notitle"}

@@ -14,6 +14,9 @@ void QuadricReconstruction::Params::validate() const {
     throw std::invalid_argument(
         "QuadricReconstruction::Params::max_points_per_landmark must be >= 1, got " +
         std::to_string(max_points_per_landmark));
+  if (max_points < 1)
+    throw std::invalid_argument("QuadricReconstruction::Params::max_points must be >= 1, got " +
+                                std::to_string(max_points));
   if (!(max_surface_distance > 0.0))
     throw std::invalid_argument(
         "QuadricReconstruction::Params::max_surface_distance must be > 0 (m), got " +
@@ -27,10 +30,12 @@ QuadricReconstruction::QuadricReconstruction(const Params& params) : params_(par
 }
 
 std::uint64_t QuadricReconstruction::voxelKey(const Eigen::Vector3d& p_quadric) const {
-  // 21 bits per axis (two's complement, wrapped): unique within +-10 km at 1 cm voxels.
+  // 21 bits per axis (two's complement, wrapped): unique within +-10 km at 1 cm voxels. Voxels
+  // are centred on the quadric frame's axes, so a plane (z = 0 in its frame) lies in the middle
+  // of one layer of voxels rather than on the boundary between two.
   const auto axis = [&](double value) {
     return static_cast<std::uint64_t>(
-               static_cast<std::int64_t>(std::floor(value / params_.voxel_size))) &
+               static_cast<std::int64_t>(std::floor(value / params_.voxel_size + 0.5))) &
            ((std::uint64_t{1} << 21) - 1);
   };
   return axis(p_quadric.x()) | axis(p_quadric.y()) << 21 | axis(p_quadric.z()) << 42;
@@ -45,12 +50,13 @@ int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
         "QuadricReconstruction::addPoints: " + std::to_string(colours_rgba.size()) +
         " colours for " + std::to_string(points_camera.size()) + " points");
   LandmarkPoints& stored = landmarks_[id];
-  const Eigen::Isometry3d T_quadric_camera = landmark_map.pose().inverse() * T_map_camera;
+  const Eigen::Isometry3d T_quadric_map = landmark_map.pose().inverse();
   const bool exact = landmark_map.quadricClass() != QuadricClass::kGeneral;
   int added = 0;
   for (std::size_t i = 0; i < points_camera.size(); ++i) {
     const Eigen::Vector3f& point = points_camera[i];
-    if (static_cast<int>(stored.points_quadric.size()) >= params_.max_points_per_landmark)
+    if (static_cast<int>(stored.points_quadric.size()) >= params_.max_points_per_landmark ||
+        total_points_ + added >= static_cast<std::size_t>(params_.max_points))
       break;
     if (!point.allFinite())
       continue;
@@ -59,7 +65,15 @@ int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
         exact ? exactDistance(landmark_map, p_map) : firstOrderDistance(landmark_map, p_map);
     if (!(distance <= params_.max_surface_distance))
       continue;
-    const Eigen::Vector3d p_quadric = T_quadric_camera * point.cast<double>();
+    // Stored on the surface: the sensor's noise along the normal would otherwise spread one
+    // patch of surface over a stack of voxels, and every pass over it would add points (the map
+    // grows over time without seeing anything new).
+    Eigen::Vector3d p_quadric;
+    try {
+      p_quadric = T_quadric_map * projector_.project(landmark_map, p_map);
+    } catch (const std::invalid_argument&) {
+      continue;  // a general quadric whose projection does not converge from here
+    }
     if (!stored.voxels.insert(voxelKey(p_quadric)).second)
       continue;
     if (!colours_rgba.empty() && (colours_rgba[i] >> 24) != 0) {
@@ -69,6 +83,7 @@ int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
     stored.points_quadric.push_back(p_quadric.cast<float>());
     ++added;
   }
+  total_points_ += added;
   if (stored.points_quadric.empty())
     landmarks_.erase(id);
   return added;
@@ -80,6 +95,7 @@ void QuadricReconstruction::moveLandmark(int from, int to, const Eigen::Isometry
     return;
   LandmarkPoints& target = landmarks_[to];
   const LandmarkPoints& moved = source->second;
+  total_points_ -= moved.points_quadric.size() + target.points_quadric.size();
   for (std::size_t i = 0; i < moved.points_quadric.size(); ++i) {
     if (static_cast<int>(target.points_quadric.size()) >= params_.max_points_per_landmark)
       break;
@@ -94,24 +110,28 @@ void QuadricReconstruction::moveLandmark(int from, int to, const Eigen::Isometry
     }
     target.points_quadric.push_back(p_to.cast<float>());
   }
+  total_points_ += target.points_quadric.size();
   landmarks_.erase(from);
   if (landmarks_[to].points_quadric.empty())
     landmarks_.erase(to);
 }
 
 void QuadricReconstruction::removeLandmark(int id) {
+  total_points_ -= size(id);
   landmarks_.erase(id);
 }
 
 void QuadricReconstruction::clear() {
   landmarks_.clear();
+  total_points_ = 0;
 }
 
 std::size_t QuadricReconstruction::size() const {
-  std::size_t total = 0;
-  for (const auto& [id, stored] : landmarks_)
-    total += stored.points_quadric.size();
-  return total;
+  return total_points_;
+}
+
+bool QuadricReconstruction::full() const {
+  return total_points_ >= static_cast<std::size_t>(params_.max_points);
 }
 
 std::size_t QuadricReconstruction::size(int id) const {

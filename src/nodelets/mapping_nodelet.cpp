@@ -70,6 +70,7 @@
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/SaveMap.h"
 #include "quadric_slam/eval/recent_durations.h"
+#include "quadric_slam/eval/resource_usage.h"
 #include "quadric_slam/frontend/support_colours.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
@@ -689,6 +690,10 @@ class MappingNodelet : public nodelet::Nodelet {
 
   void publishReconstruction(const ros::Time& stamp) {
     reconstruction_pub_.publish(reconstructionCloud(stamp));
+    // The whole-map cloud and its message were the largest buffers of the frame and grow with the
+    // map: give their pages back, or the manager's resident memory ratchets up by a cloud's size
+    // every few publications (eval/resource_usage.h).
+    releaseFreeHeapMemory();
   }
 
   void appendPath(const ros::Time& stamp, const Eigen::Isometry3d& T_map_camera) {
@@ -732,6 +737,7 @@ class MappingNodelet : public nodelet::Nodelet {
     std::map<std::string, int> landmarks_per_class;
     int landmarks = 0, candidates = 0;
     long reconstruction_points = 0;  // what a long run grows until the surfaces are covered
+    bool reconstruction_full = false;
     std::string observation_frame, camera_frame;  // of the latest frame (observations, odom child)
     std::string mode = "mapping";                 // or "localisation only"
     std::string loaded_from;                      // the loaded map file, if any
@@ -753,6 +759,7 @@ class MappingNodelet : public nodelet::Nodelet {
     stats_.landmarks = static_cast<int>(mapper_->map().landmarks().size());
     stats_.candidates = static_cast<int>(mapper_->map().candidates().size());
     stats_.reconstruction_points = static_cast<long>(reconstruction_->size());
+    stats_.reconstruction_full = reconstruction_->full();
     stats_.mode = recovery_.recovering() && !user_localization_only_
                       ? "relocalising after a loss of tracking (localisation only)"
                   : mapper_->localizationOnly() ? "localisation only"
@@ -800,6 +807,14 @@ class MappingNodelet : public nodelet::Nodelet {
     status.add("loaded map", s.loaded_from.empty() ? std::string("none") : s.loaded_from);
     status.add("landmarks", s.landmarks);
     status.add("reconstruction points", s.reconstruction_points);
+    status.add("reconstruction full (reconstruction_max_points: new points dropped)",
+               s.reconstruction_full ? "yes" : "no");
+    // Of the whole process (every nodelet of the manager): the resident memory a long run should
+    // keep flat, and how much of it is data in use rather than freed memory the allocator holds.
+    const HeapUsage heap = heapUsage();
+    status.addf("process resident memory (MB)", "%.1f", residentMemoryBytes() / 1048576.0);
+    status.addf("process heap in use (MB)", "%.1f", heap.in_use / 1048576.0);
+    status.addf("process heap held free (MB)", "%.1f", heap.held_free / 1048576.0);
     for (const auto& [name, count] : s.landmarks_per_class)
       status.add("landmarks: " + name, count);
     status.add("candidates", s.candidates);

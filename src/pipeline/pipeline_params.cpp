@@ -106,6 +106,7 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
   readParam(reader, "reconstruction_voxel_size", reconstruction.voxel_size, log);
   readParam(reader, "reconstruction_max_points_per_landmark",
             reconstruction.max_points_per_landmark, log);
+  readParam(reader, "reconstruction_max_points", reconstruction.max_points, log);
   readParam(reader, "reconstruction_max_surface_distance", reconstruction.max_surface_distance,
             log);
   mapper.validate();

@@ -7,7 +7,7 @@
 //
 // SERIES.csv (optional, for long runs): one row per status received, as it arrives:
 //   wall_s (since the start), name, frames processed, processing median and p95 (ms), landmarks,
-//   reconstruction points (the mapper's)
+//   reconstruction points and the process's heap in use in MB (the mapper's)
 // (a field the status does not carry is left empty).
 //
 // OUT.yaml: {<status name>: {level: <0 OK, 1 WARN, 2 ERROR, 3 STALE>, message: <text>,
@@ -32,7 +32,8 @@ int main(int argc, char** argv) {
   std::ofstream series;
   if (argc == 3) {
     series.open(argv[2]);
-    series << "wall_s,name,frames_processed,median_ms,p95_ms,landmarks,reconstruction_points\n";
+    series << "wall_s,name,frames_processed,median_ms,p95_ms,landmarks,reconstruction_points,"
+              "heap_in_use_mb\n";
   }
   const ros::WallTime start = ros::WallTime::now();
   const auto value = [](const diagnostic_msgs::DiagnosticStatus& status, const std::string& key) {
@@ -55,7 +56,8 @@ int main(int argc, char** argv) {
                    << value(status, "frames processed") << ','
                    << value(status, "processing time median (ms)") << ','
                    << value(status, "processing time p95 (ms)") << ',' << value(status, "landmarks")
-                   << ',' << value(status, "reconstruction points") << '\n';
+                   << ',' << value(status, "reconstruction points") << ','
+                   << value(status, "process heap in use (MB)") << '\n';
           }
         }
       });

@@ -11,7 +11,9 @@
 //                            rgba = the pixel's colour when the input has RGB, alpha 255, else
 //                            the landmark's colour, alpha 0: ros/reconstruction_cloud.h)
 //   DIR/resources.csv        every --sample-every frames: resident memory, frame time, landmarks,
-//                            candidates and reconstruction points (what a long run may grow)
+//                            candidates, reconstruction points (what a long run may grow) and
+//                            the heap in use (eval/resource_usage.h: resident memory less what
+//                            the allocator holds free)
 // With --gt prints the ATE and RPE of the odometry (ate_rmse_m ...) and of SLAM (map_ate_rmse_m
 // ...). INPUT may also be a scene file (config/scenes/*.yaml): its frames are rendered as they are
 // needed (sim/synthetic_frame_source.h), so a sequence of any length runs without a bag; the truth
@@ -214,7 +216,7 @@ int main(int argc, char** argv) {
     // Long-run curves: memory, time per frame and map size every sample_every frames.
     std::ofstream resources(o.out_dir + "/resources.csv");
     resources << "frames,stamp_s,elapsed_s,rss_mb,ms_per_frame,landmarks,candidates,"
-                 "reconstruction_points\n";
+                 "reconstruction_points,heap_in_use_mb\n";
     auto last_sample = std::chrono::steady_clock::now();
     if (!o.quiet) {
       std::cerr << "run_bag: " << o.input << ": " << total << " frames, config " << o.config_dir
@@ -277,6 +279,7 @@ int main(int argc, char** argv) {
                          in_interval
                   << ',' << slam.mapper().map().landmarks().size() << ','
                   << slam.mapper().map().candidates().size() << ',' << slam.reconstruction().size()
+                  << ',' << qs::heapUsage().in_use / 1048576.0
                   << std::endl;  // flushed: the curve can be watched during a long run
         last_sample = now;
       }

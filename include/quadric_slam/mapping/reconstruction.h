@@ -2,11 +2,11 @@
 // points of a landmark's observations, drawn projected onto the landmark's current surface
 // estimate.
 //
-// Points are stored in the landmark's own quadric frame (as estimated when they were added), one
-// per voxel of that frame, so memory is bounded by the observed area rather than by the number of
-// frames, and a landmark whose estimate moves carries its points with it: cloud() places every
-// point with the current T_map_quadric and projects it onto the current surface
-// (geometry/surface_distance.h). Each point may carry the RGB colour of the pixel it came from
+// Points are stored projected onto the landmark's surface, in its own quadric frame (as estimated
+// when they were added), one per voxel of that frame, so memory is bounded by the observed area
+// rather than by the number of frames or the depth noise, and a landmark whose estimate moves
+// carries its points with it: cloud() places every point with the current T_map_quadric and
+// projects it onto the current surface (geometry/surface_distance.h). Each point may carry the RGB colour of the pixel it came from
 // (frontend/support_colours.h), packed 0xAARRGGBB, alpha 0 = uncoloured.
 #pragma once
 
@@ -30,6 +30,10 @@ class QuadricReconstruction {
   struct Params {
     double voxel_size = 0.01;              // m: at most one point per voxel of a quadric frame, > 0
     int max_points_per_landmark = 100000;  // further points of a landmark are dropped, >= 1
+    // Over the whole map, >= 1: memory stays bounded (about 100 bytes a point) even where the
+    // observed area is not, e.g. a map grown over a whole building. Once full, further points
+    // are dropped (full() says so); the landmarks themselves are still estimated and published.
+    int max_points = 3000000;
     double max_surface_distance = 0.05;    // m: points farther from the surface are outliers, > 0
     void validate() const;  // throws std::invalid_argument naming the field and its range
   };
@@ -40,8 +44,8 @@ class QuadricReconstruction {
   // Adds the supporting points (camera frame) of landmark `id` seen from T_map_camera, given the
   // landmark's current estimate in the map frame. Points that are not finite, or farther than
   // max_surface_distance from the surface (exact distance for the classes of revolution and planes,
-  // first-order for general quadrics), are skipped, as are points in an occupied voxel. Returns how
-  // many points were stored. colours_rgba: one packed colour per point (alpha 0 = none), or empty
+  // first-order for general quadrics), are skipped, as are points in an occupied voxel and points
+  // beyond max_points_per_landmark or max_points. Returns how many points were stored. colours_rgba: one packed colour per point (alpha 0 = none), or empty
   // for uncoloured points; a voxel keeps the colour of the point that occupied it first.
   int addPoints(int id, const QuadricModel& landmark_map, const Eigen::Isometry3d& T_map_camera,
                 const std::vector<Eigen::Vector3f>& points_camera,
@@ -49,12 +53,14 @@ class QuadricReconstruction {
 
   // Landmark `from` was merged into `to` (mapping/landmark_merger.h): its points join `to`'s,
   // re-expressed with T_to_from (from's quadric frame in to's), one per voxel of to's frame and
-  // within max_points_per_landmark; `from` has no points afterwards.
+  // within max_points_per_landmark (a merge never adds points to the map, so max_points holds);
+  // `from` has no points afterwards.
   void moveLandmark(int from, int to, const Eigen::Isometry3d& T_to_from);
   void removeLandmark(int id);
   void clear();
 
   std::size_t size() const;        // points stored over all landmarks
+  bool full() const;               // size() reached max_points: new points are dropped
   std::size_t size(int id) const;  // points stored for one landmark (0 when unknown)
 
   // The stored points of every landmark in `landmarks_map` (id -> current estimate, map frame),
@@ -77,6 +83,7 @@ class QuadricReconstruction {
   Params params_;
   SurfaceProjector projector_;
   std::map<int, LandmarkPoints> landmarks_;
+  std::size_t total_points_ = 0;  // size(), kept as points come and go
 };
 
 }  // namespace quadric_slam

@@ -154,6 +154,81 @@ TEST(QuadricReconstruction, OutliersNaNsAndTheCapAreRespected) {
   EXPECT_EQ(small.size(), 0u);
 }
 
+// A patch of surface seen again and again through a noisy sensor: the points go onto the surface
+// before they take a voxel, so the noise along the normal adds no points after the first passes.
+TEST(QuadricReconstruction, RepeatedNoisyViewsOfOnePatchDoNotGrowIt) {
+  qs::PlaneShape shape;
+  shape.normal = Eigen::Vector3d(0, 0, 1);
+  const qs::QuadricModel floor = qs::quadricFromShape(shape);
+  qs::SphereShape ball_shape;
+  ball_shape.center = Eigen::Vector3d(0, 0, 1);
+  ball_shape.radius = 0.3;
+  const qs::QuadricModel ball = qs::quadricFromShape(ball_shape);
+  const Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
+  std::mt19937 random(3);
+  std::normal_distribution<float> depth_noise(0.f, 0.004f);  // 4 mm along the normal
+  std::uniform_real_distribution<float> where(0.f, 0.2f);    // a 20 cm x 20 cm patch
+  qs::QuadricReconstruction reconstruction;
+  std::size_t after_first_passes = 0;
+  for (int pass = 0; pass < 60; ++pass) {
+    std::vector<Eigen::Vector3f> floor_points, ball_points;
+    for (int i = 0; i < 2000; ++i) {
+      floor_points.emplace_back(where(random), where(random), depth_noise(random));
+      // The ball's cap facing -z: directions within the patch, radius perturbed.
+      const Eigen::Vector3f direction =
+          Eigen::Vector3f(where(random) - 0.1f, where(random) - 0.1f, -0.3f).normalized();
+      ball_points.push_back(Eigen::Vector3f(0, 0, 1) + (0.3f + depth_noise(random)) * direction);
+    }
+    reconstruction.addPoints(1, floor, T_map_camera, floor_points);
+    reconstruction.addPoints(2, ball, T_map_camera, ball_points);
+    if (pass == 9)
+      after_first_passes = reconstruction.size();
+  }
+  // The patch holds 20 x 20 voxels of floor plus the cap's (under 2 x its ~21 x 21 cm area: a
+  // curved surface crosses voxel layers); noisy points off the surface would keep adding more.
+  EXPECT_LE(reconstruction.size(1), 21u * 21u);
+  EXPECT_LE(reconstruction.size(2), 2u * 22u * 22u);
+  EXPECT_LE(reconstruction.size(), after_first_passes + after_first_passes / 50);
+}
+
+// The map-wide cap: once max_points are stored over all landmarks no landmark gains any, while
+// merges and removals keep the count exact (a merge never adds points; a removal frees room).
+TEST(QuadricReconstruction, MapWideCapBoundsEveryLandmarkTogether) {
+  qs::PlaneShape shape;
+  shape.normal = Eigen::Vector3d(0, 0, 1);
+  const qs::QuadricModel floor = qs::quadricFromShape(shape);
+  const Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Vector3f> row;  // 40 points 2 cm apart: 40 voxels
+  for (int i = 0; i < 40; ++i)
+    row.emplace_back(0.02f * i, 0.f, 0.f);
+  std::vector<Eigen::Vector3f> other_row = row;
+  for (Eigen::Vector3f& p : other_row)
+    p.y() = 0.5f;
+
+  qs::QuadricReconstruction::Params params;
+  params.max_points = 50;
+  qs::QuadricReconstruction reconstruction(params);
+  EXPECT_EQ(reconstruction.addPoints(1, floor, T_map_camera, row), 40);
+  EXPECT_FALSE(reconstruction.full());
+  EXPECT_EQ(reconstruction.addPoints(2, floor, T_map_camera, other_row), 10);
+  EXPECT_TRUE(reconstruction.full());
+  EXPECT_EQ(reconstruction.addPoints(3, floor, T_map_camera, row), 0);
+  EXPECT_EQ(reconstruction.size(), 50u);
+  EXPECT_EQ(reconstruction.cloud({{1, floor}, {2, floor}, {3, floor}}).size(), 50u);
+
+  // Landmark 2 merged into 1 (same frame): its 10 points lie in voxels 1 does not hold.
+  reconstruction.moveLandmark(2, 1, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(reconstruction.size(1), 50u);
+  EXPECT_EQ(reconstruction.size(2), 0u);
+  EXPECT_EQ(reconstruction.size(), 50u);
+
+  reconstruction.removeLandmark(1);
+  EXPECT_EQ(reconstruction.size(), 0u);
+  EXPECT_FALSE(reconstruction.full());
+  EXPECT_EQ(reconstruction.addPoints(3, floor, T_map_camera, row), 40);
+  EXPECT_EQ(reconstruction.size(), 40u);
+}
+
 TEST(QuadricReconstruction, ParamsValidateNamesTheField) {
   qs::QuadricReconstruction::Params params;
   params.voxel_size = 0.0;
@@ -165,6 +240,9 @@ TEST(QuadricReconstruction, ParamsValidateNamesTheField) {
   }
   params = {};
   params.max_points_per_landmark = 0;
+  EXPECT_THROW(params.validate(), std::invalid_argument);
+  params = {};
+  params.max_points = 0;
   EXPECT_THROW(params.validate(), std::invalid_argument);
   params = {};
   params.max_surface_distance = -1.0;
@@ -190,10 +268,10 @@ TEST(QuadricReconstruction, MovedLandmarkPointsKeepTheirPlaceInTheMap) {
   std::vector<Eigen::Vector3d> b_map;
   for (int i = 0; i < 20; ++i) {
     for (int j = 0; j < 10; ++j) {
-      // In the middle of voxels (5 mm above the floor, 5 mm off the grid lines), so that float
-      // rounding of the stored points cannot move them across a voxel boundary.
-      const Eigen::Vector3d pa(0.005 + 0.05 * i, 0.005 + 0.05 * j, 0.005),
-          pb(1.505 + 0.05 * i, 0.005 + 0.05 * j, 0.005);
+      // 5 mm above the floor (they are stored projected onto it), in the middle of voxels (which
+      // are centred on the grid lines) so that float rounding of the stored points cannot move
+      // them across a voxel boundary.
+      const Eigen::Vector3d pa(0.05 * i, 0.05 * j, 0.005), pb(1.5 + 0.05 * i, 0.05 * j, 0.005);
       points_a.push_back((T_map_camera.inverse() * pa).cast<float>());
       points_b.push_back((T_map_camera.inverse() * pb).cast<float>());
       b_map.push_back(pb - Eigen::Vector3d(0, 0, 0.005));  // where the cloud projects it
