@@ -4,7 +4,7 @@
 // blind (a covered lens, a gap in a bag): the odometry's pose then associates with nothing.
 //
 // The frame's surfaces (camera frame, planes facing the camera) are aligned with the landmarks'
-// (map frame, planes of either side) by mapping/surface_matcher.h; a candidate pair must also
+// (map frame, planes of either side) by geometry/surface_matcher.h; a candidate pair must also
 // have overlapping observed extents under the pose (a wall's fragment must lie on the mapped part
 // of that wall, grown by extent_margin), which removes most symmetric solutions of a box-like room.
 // The best alignment is refined by least squares and accepted only when
@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "quadric_slam/mapping/landmark.h"
-#include "quadric_slam/mapping/surface_matcher.h"
+#include "quadric_slam/geometry/surface_matcher.h"
 #include "quadric_slam/types/observation.h"
 
 namespace quadric_slam {

@@ -1,18 +1,18 @@
 // A motion guess between two frames from their quadric observations alone, for steps too large for
 // ICP's basin (frames far apart in time, a busy pipeline that drops frames).
 //
-// It uses what does not depend on the pose: the angle between two surfaces' directions (plane
-// normals, cone axes, cylinder axes), radii and cone angles. A pair of non-parallel directions
-// seen in both frames with the same angle between them gives the rotation (Kabsch on the two
-// directions and their cross product). Under that rotation the two planes (or axes) fix the
-// translation up to one line, t = t0 + s m with m along their cross product; every other
-// compatible pair of surfaces votes for s (a plane by its offset, a sphere or cone by its centre or
-// apex, a cylinder by its axis), and the densest cluster of votes wins. The hypothesis that most
-// surfaces agree with is refined by least squares over all of them and returned.
+// The two frames' surfaces are aligned by geometry/surface_matcher.h, which uses what does not
+// depend on the pose (the angle between two surfaces' directions, radii, cone angles): a pair of
+// non-parallel directions seen in both frames gives a rotation, the pair's surfaces a line of
+// translations, and each other compatible pair a translation on it, scored by the surfaces that
+// then coincide. The proposal most surfaces agree with is refined by least squares over all of
+// them and returned.
 //
 // Hypotheses are confined to rotations within max_rotation_from_prior of the prior (the
 // constant-velocity prediction), which removes the symmetric solutions of a box-like room (a
-// 90-degree turn maps its walls onto each other as well as the true motion does).
+// 90-degree turn maps its walls onto each other as well as the true motion does); the prior also
+// fills a translation direction the surfaces leave free, and decides between proposals of equal
+// support.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "quadric_slam/geometry/surface_matcher.h"
 #include "quadric_slam/types/observation.h"
 
 namespace quadric_slam {
@@ -77,6 +78,7 @@ class QuadricMotionGuesser {
 
  private:
   Params params_;
+  SurfaceMatcher matcher_;
 };
 
 }  // namespace quadric_slam

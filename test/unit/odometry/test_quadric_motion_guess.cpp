@@ -90,6 +90,38 @@ TEST(QuadricMotionGuess, RecoversALargeStepFromAnIdentityPrior) {
   EXPECT_FALSE(guess.translation_from_prior);
 }
 
+// Parallel surfaces at different offsets (a table top above the floor) share one rotation but give
+// different lines of translations. When the largest surface of each frame is a different one of
+// them, the first pair tried under that rotation matches the table top with the floor: the guess
+// must still try the line of the right match rather than keep the rotation's first line (which
+// three surfaces agree with, 0.75 m off).
+TEST(QuadricMotionGuess, TriesEveryLineOfARotationSharedByParallelSurfaces) {
+  std::mt19937 rng(11);
+  const std::vector<QuadricModel> room = {
+      quadricFromShape(PlaneShape{Eigen::Vector3d::UnitZ(), 0.0}),    // floor
+      quadricFromShape(PlaneShape{Eigen::Vector3d::UnitZ(), 0.75}),   // table top
+      quadricFromShape(PlaneShape{Eigen::Vector3d::UnitX(), 3.0}),    // wall x = 3
+      quadricFromShape(PlaneShape{Eigen::Vector3d::UnitY(), 3.5})};   // wall y = 3.5
+  const Eigen::Isometry3d T_world_reference =
+      cameraAt(Eigen::Vector3d(0.2, 0.3, 1.4), Eigen::Vector3d(2.5, 2.5, 0.8));
+  const Eigen::Isometry3d T_world_current =
+      cameraAt(Eigen::Vector3d(0.4, 0.2, 1.5), Eigen::Vector3d(2.7, 2.2, 0.7));
+  const Eigen::Isometry3d truth = T_world_reference.inverse() * T_world_current;
+  std::vector<QuadricMeasurement> reference = observe(room, T_world_reference, rng);
+  std::vector<QuadricMeasurement> current = observe(room, T_world_current, rng);
+  // The floor fills the reference view, the table top the current one.
+  reference[0].num_points = 40000;
+  reference[1].num_points = 3000;
+  current[0].num_points = 3000;
+  current[1].num_points = 40000;
+
+  const QuadricMotionGuess guess =
+      QuadricMotionGuesser().guess(reference, current, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(guess.found) << guess.message;
+  expectNear(guess.T_reference_current, truth, 1e-6, 1e-6);
+  EXPECT_EQ(guess.supporting_surfaces, 4);
+}
+
 TEST(QuadricMotionGuess, ToleratesFitNoiseMissingAndSpuriousSurfaces) {
   std::mt19937 rng(5);
   const std::vector<QuadricModel> room = roomSurfaces();

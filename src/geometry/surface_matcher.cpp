@@ -1,4 +1,4 @@
-#include "quadric_slam/mapping/surface_matcher.h"
+#include "quadric_slam/geometry/surface_matcher.h"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
@@ -72,8 +72,9 @@ struct Pair {
 class Hypotheses {
  public:
   Hypotheses(const SurfaceMatcher::Params& params, const std::vector<MatchableSurface>& reference,
-             const std::vector<MatchableSurface>& current, const SurfaceMatcher::PairTest& test)
-      : p_(params), ref_(reference), cur_(current), test_(test) {}
+             const std::vector<MatchableSurface>& current, const SurfaceMatcher::PairTest& test,
+             const MotionPrior* prior)
+      : p_(params), ref_(reference), cur_(current), test_(test), prior_(prior) {}
 
   bool sameShape(const MatchableSurface& c, const MatchableSurface& r) const {
     if (c.kind != r.kind)
@@ -143,16 +144,49 @@ class Hypotheses {
     return 0.0;
   }
 
-  // Least-squares translation; a direction the constraints leave free stays at zero (a tiny
-  // regulariser), and the conditioning says so.
-  static Eigen::Vector3d solve(Eigen::Matrix3d AtA, const Eigen::Vector3d& Atb,
-                               double* conditioning) {
+  // Least-squares translation; a direction the constraints leave free takes the prior's
+  // translation (zero without a prior) through a small regulariser, and the conditioning says so.
+  Eigen::Vector3d solve(Eigen::Matrix3d AtA, Eigen::Vector3d Atb, double* conditioning) const {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(AtA);
     const double largest = std::max(eig.eigenvalues()(2), 1e-12);
     if (conditioning)
       *conditioning = std::max(0.0, eig.eigenvalues()(0)) / largest;
-    AtA += 1e-9 * largest * Eigen::Matrix3d::Identity();
+    // A prior is trusted a little where the data is weak, not only where it says nothing.
+    const double weight = (prior_ ? 1e-6 : 1e-9) * largest;
+    AtA += weight * Eigen::Matrix3d::Identity();
+    if (prior_)
+      Atb += weight * prior_->T_reference_current.translation();
     return AtA.ldlt().solve(Atb);
+  }
+
+  bool withinPrior(const Eigen::Matrix3d& R) const {
+    return !prior_ || rotationAngle(R, prior_->T_reference_current.linear()) <= prior_->max_rotation;
+  }
+  bool withinPrior(const Eigen::Vector3d& t) const {
+    return !prior_ ||
+           (t - prior_->T_reference_current.translation()).norm() <= prior_->max_translation;
+  }
+  // Distance of a pose from the prior: 1 m per rad (0 without a prior).
+  double distanceFromPrior(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) const {
+    if (!prior_)
+      return 0.0;
+    return (t - prior_->T_reference_current.translation()).norm() +
+           rotationAngle(R, prior_->T_reference_current.linear());
+  }
+  static double rotationAngle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+    return Eigen::AngleAxisd(a * b.transpose()).angle();
+  }
+  // More agreeing surface (by weight); with a prior, among nearly equal supports, the proposal
+  // nearer the prior.
+  bool better(const SurfaceAlignment& s, double s_distance, const SurfaceAlignment& best,
+              double best_distance) const {
+    if (best.supporting == 0)
+      return s.supporting > 0;
+    if (!prior_)
+      return s.weight > best.weight;
+    return s.weight > best.weight * 1.02 ||
+           (s.weight >= best.weight * 0.98 && s.supporting >= best.supporting &&
+            s_distance < best_distance);
   }
 
   SurfaceAlignment score(const std::vector<Pair>& candidates, const Eigen::Matrix3d& R,
@@ -197,6 +231,7 @@ class Hypotheses {
   const std::vector<MatchableSurface>& ref_;
   const std::vector<MatchableSurface>& cur_;
   const SurfaceMatcher::PairTest& test_;
+  const MotionPrior* prior_;  // may be null
 };
 
 std::vector<SurfaceAlignment> Hypotheses::run() const {
@@ -212,7 +247,7 @@ std::vector<SurfaceAlignment> Hypotheses::run() const {
   struct TriedRotation {
     Eigen::Quaterniond q;
     std::vector<Pair> candidates;
-    std::vector<Eigen::Vector3d> lines;  // the point of each tried line nearest the origin
+    std::vector<Eigen::Vector3d> lines;  // a point of each tried line (the one solve() picks)
   };
   std::vector<TriedRotation> tried;
   const auto rotationEntry = [&](const Eigen::Matrix3d& R) -> TriedRotation& {
@@ -246,6 +281,8 @@ std::vector<SurfaceAlignment> Hypotheses::run() const {
               kabsch({ca.direction, cb.direction, ca.direction.cross(cb.direction).normalized()},
                      {ra.direction, rb.direction, ra.direction.cross(rb.direction).normalized()},
                      {1.0, 1.0, 1.0});
+          if (!withinPrior(R))
+            continue;
           TriedRotation& entry = rotationEntry(R);
           const std::vector<Pair>& candidates = entry.candidates;
           // The two defining pairs, then each other candidate in turn as the third constraint.
@@ -253,7 +290,8 @@ std::vector<SurfaceAlignment> Hypotheses::run() const {
           Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
           addConstraints(cur_[ca.surface], ref_[ra.surface], R, 1.0, AtA, Atb);
           addConstraints(cur_[cb.surface], ref_[rb.surface], R, 1.0, AtA, Atb);
-          const Eigen::Vector3d line = solve(AtA, Atb, nullptr);  // its point nearest the origin
+          // The line's point nearest the prior's translation (the origin without a prior).
+          const Eigen::Vector3d line = solve(AtA, Atb, nullptr);
           bool line_tried = false;
           for (const Eigen::Vector3d& other : entry.lines)
             line_tried = line_tried || (other - line).norm() < p_.max_offset_difference;
@@ -261,6 +299,19 @@ std::vector<SurfaceAlignment> Hypotheses::run() const {
             continue;
           entry.lines.push_back(line);
           SurfaceAlignment best;
+          double best_distance = 0.0;
+          const auto consider = [&](const Eigen::Vector3d& t) {
+            if (!withinPrior(t))
+              return;
+            SurfaceAlignment s = score(candidates, R, t);
+            const double distance = distanceFromPrior(R, t);
+            if (better(s, distance, best, best_distance)) {
+              best = std::move(s);
+              best_distance = distance;
+            }
+          };
+          if (prior_)
+            consider(line);  // the line's point nearest the prior: what two surfaces say
           for (const Pair& third : candidates) {
             if (third.current == ca.surface || third.current == cb.surface)
               continue;
@@ -269,11 +320,9 @@ std::vector<SurfaceAlignment> Hypotheses::run() const {
             addConstraints(cur_[third.current], ref_[third.reference], R, 1.0, A3, b3);
             double conditioning = 0.0;
             const Eigen::Vector3d t = solve(A3, b3, &conditioning);
-            if (conditioning < 1e-3)
+            if (conditioning < 1e-3 && !prior_)
               continue;  // the three leave a direction free: no position from them
-            SurfaceAlignment s = score(candidates, R, t);
-            if (s.weight > best.weight)
-              best = std::move(s);
+            consider(t);
           }
           if (best.supporting > 0)
             out.push_back(std::move(best));
@@ -370,15 +419,16 @@ SurfaceMatcher::SurfaceMatcher(const Params& params) : params_((params.validate(
 
 std::vector<SurfaceAlignment> SurfaceMatcher::align(const std::vector<MatchableSurface>& reference,
                                                     const std::vector<MatchableSurface>& current,
-                                                    const PairTest& test) const {
-  return Hypotheses(params_, reference, current, test).run();
+                                                    const PairTest& test,
+                                                    const MotionPrior* prior) const {
+  return Hypotheses(params_, reference, current, test, prior).run();
 }
 
 SurfaceAlignment SurfaceMatcher::refine(const std::vector<MatchableSurface>& reference,
                                         const std::vector<MatchableSurface>& current,
-                                        const SurfaceAlignment& alignment,
-                                        const PairTest& test) const {
-  const Hypotheses hypotheses(params_, reference, current, test);
+                                        const SurfaceAlignment& alignment, const PairTest& test,
+                                        const MotionPrior* prior) const {
+  const Hypotheses hypotheses(params_, reference, current, test, prior);
   const Eigen::Matrix3d R0 = alignment.T_reference_current.linear();
   std::vector<Eigen::Vector3d> u, v;
   std::vector<double> w;
@@ -408,7 +458,7 @@ SurfaceAlignment SurfaceMatcher::refine(const std::vector<MatchableSurface>& ref
     Hypotheses::addConstraints(current[c_index], reference[r_index], R, current[c_index].weight,
                                AtA, Atb);
   double conditioning = 0.0;
-  const Eigen::Vector3d t = Hypotheses::solve(AtA, Atb, &conditioning);
+  const Eigen::Vector3d t = hypotheses.solve(AtA, Atb, &conditioning);
   // Re-score under the refined pose; the rotation may have moved a direction out of the gate.
   std::vector<Pair> candidates;
   for (std::size_t i = 0; i < current.size(); ++i)

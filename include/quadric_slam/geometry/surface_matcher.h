@@ -1,37 +1,43 @@
-// Rigid alignment of two sets of quadric surfaces without known correspondences and without a pose
-// prior: the frame's observations (camera frame) against a reference set (another frame's
-// observations, or the map's landmarks in the map frame).
+// Rigid alignment of two sets of quadric surfaces without known correspondences: a frame's
+// observations (camera frame) against a reference set (another frame's observations, or the map's
+// landmarks in the map frame). Used without a pose prior to relocalise in a map
+// (mapping/relocaliser.h) and with the constant-velocity prediction as a prior to guess the motion
+// between two frames too far apart for ICP (odometry/quadric_motion_guess.h).
 //
-// It compares what does not depend on the pose (the ideas of odometry/quadric_motion_guess.h,
-// generalised to a reference whose viewing side is unknown): the class, radii and cone angles,
-// and the angle between two surfaces' directions (plane normals, cylinder and cone axes). Each pair
-// of non-parallel current directions and each reference pair with the same angle between them
-// gives a rotation (Kabsch on the two directions and their cross product). Under that rotation
-// the two defining surfaces fix the translation up to a line; every other compatible pair added
-// as a third constraint proposes a translation (a plane by its offset n.t = d_r - d_c, a sphere
-// centre or cone apex by R c + t = c_r, a cylinder by its axis across the axis), and each proposal
-// is scored by the current surfaces that then coincide with a reference surface (sum of their
-// weights). Returns the best proposal per distinct rotation, best first, so that the caller can
-// see how far the runner-up is behind (a box-like room has symmetric solutions: a 90-degree turn
-// maps its walls onto each other).
+// It compares what does not depend on the pose: the class, radii and cone angles, and the angle
+// between two surfaces' directions (plane normals, cylinder and cone axes). Each pair of
+// non-parallel current directions and each reference pair with the same angle between them gives
+// a rotation (Kabsch on the two directions and their cross product). Under that rotation the two
+// defining surfaces fix the translation up to a line; every other compatible pair added as a
+// third constraint proposes a translation (a plane by its offset n.t = d_r - d_c, a sphere centre
+// or cone apex by R c + t = c_r, a cylinder by its axis across the axis), and each proposal is
+// scored by the current surfaces that then coincide with a reference surface (sum of their
+// weights). Returns the best proposal per distinct rotation and line of translations, best
+// first, so that the caller can see how far the runner-up is behind (a box-like room has
+// symmetric solutions: a 90-degree turn maps its walls onto each other).
+//
+// A rotation shared by parallel surfaces (a table top and the floor) is tried with each distinct
+// line of translations its defining pair gives: deduplicating by the rotation alone can skip the
+// one line that holds the truth.
+//
+// With a MotionPrior, hypotheses far from it are not considered (which removes the symmetric
+// solutions), a translation direction the surfaces leave free is filled from the prior, and among
+// proposals of equal support the one nearer the prior wins.
 //
 // A map's planes have no viewing side: a reference plane whose side is unknown enters twice, once
 // per normal sign; a frame's planes are oriented towards its camera. Cylinder and cone axes are
 // compared up to their sign (a cone's quadric is the double cone: which nappe its frame names may
 // differ between a frame and the map).
 //
-// Unlike odometry/quadric_motion_guess.h (which confines hypotheses to its prior and scores each
-// distinct rotation once), a rotation shared by parallel surfaces (a table top and the floor) is
-// tried with each distinct line of translations its defining pair gives: deduplicating by the
-// rotation alone can skip the one line that holds the truth.
-//
-// Cost: grows with the number of landmarks; about 25 ms for a desk map of 11 landmarks and 0.6 s
+// Cost: grows with the number of surfaces; about 25 ms for a desk map of 11 landmarks and 0.6 s
 // for a kitchen map of about 100 (mostly parallel cabinet faces) on a loaded 2-core machine.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "quadric_slam/geometry/quadric.h"
@@ -70,6 +76,13 @@ struct SurfaceAlignment {
   double translation_conditioning = 0.0;
 };
 
+// What is known of the pose before matching (e.g. a constant-velocity prediction).
+struct MotionPrior {
+  Eigen::Isometry3d T_reference_current = Eigen::Isometry3d::Identity();
+  double max_rotation = M_PI;  // rad: rotations further from the prior's are not considered
+  double max_translation = std::numeric_limits<double>::infinity();  // m: nor translations
+};
+
 class SurfaceMatcher {
  public:
   struct Params {
@@ -97,17 +110,21 @@ class SurfaceMatcher {
   SurfaceMatcher() : SurfaceMatcher(Params{}) {}
   explicit SurfaceMatcher(const Params& params);
 
-  // The best alignment per distinct rotation hypothesis, best (largest weight) first; empty when
-  // no pair of non-parallel directions appears in both sets.
+  // The best alignment per distinct rotation and line of translations, best (largest weight)
+  // first; empty when no pair of non-parallel directions appears in both sets (within the prior's
+  // bounds, when one is given).
   std::vector<SurfaceAlignment> align(const std::vector<MatchableSurface>& reference,
                                       const std::vector<MatchableSurface>& current,
-                                      const PairTest& test = {}) const;
+                                      const PairTest& test = {},
+                                      const MotionPrior* prior = nullptr) const;
 
   // Least squares over the alignment's pairs (the rotation from all directions when they span
-  // more than one, then the translation), re-scored with `test`.
+  // more than one, then the translation; a direction they leave free from the prior's
+  // translation, or zero), re-scored with `test`.
   SurfaceAlignment refine(const std::vector<MatchableSurface>& reference,
                           const std::vector<MatchableSurface>& current,
-                          const SurfaceAlignment& alignment, const PairTest& test = {}) const;
+                          const SurfaceAlignment& alignment, const PairTest& test = {},
+                          const MotionPrior* prior = nullptr) const;
 
   const Params& params() const { return params_; }
 
