@@ -266,7 +266,95 @@ MapReport MapEvaluator::evaluate(const MapFile& truth, const MapFile& estimate,
   return report;
 }
 
-std::string formatMapReport(const MapReport& report) {
+std::map<int, double> truthRanges(const MapFile& truth,
+                                  const std::vector<Eigen::Vector3d>& camera_positions) {
+  if (camera_positions.empty())
+    throw std::invalid_argument("truthRanges: no camera positions");
+  std::map<int, double> out;
+  for (const MapFileQuadric& q : truth.quadrics) {
+    if (!isEvaluatedClass(q.quadric_class))
+      continue;
+    std::vector<double> distances;
+    distances.reserve(camera_positions.size());
+    for (const Eigen::Vector3d& p : camera_positions) {
+      if (q.quadric_class == "plane") {
+        distances.push_back(std::abs(direction(q, "normal").dot(p) - scalar(q, "offset")));
+      } else if (q.quadric_class == "sphere") {
+        distances.push_back(std::abs((p - point(q, "center")).norm() - scalar(q, "radius")));
+      } else {
+        // Axial and radial coordinates of the camera about the axis.
+        const bool cone = q.quadric_class == "cone";
+        const Eigen::Vector3d a = direction(q, "axis");
+        const Eigen::Vector3d v = p - point(q, cone ? "apex" : "point");
+        const double axial = a.dot(v);
+        const double radial = (v - axial * a).norm();
+        if (!cone) {
+          distances.push_back(std::abs(radial - scalar(q, "radius")));
+        } else {
+          // Distance to the line at half_angle from the axis (the double cone: |axial|).
+          const double alpha = scalar(q, "half_angle");
+          distances.push_back(
+              std::abs(radial * std::cos(alpha) - std::abs(axial) * std::sin(alpha)));
+        }
+      }
+    }
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2,
+                     distances.end());
+    out[q.id] = distances[distances.size() / 2];
+  }
+  return out;
+}
+
+std::string rangeBand(double range_m, const std::vector<double>& edges) {
+  const auto label = [](double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  };
+  double lower = 0.0;
+  for (double edge : edges) {
+    if (range_m < edge)
+      return label(lower) + "-" + label(edge) + "m";
+    lower = edge;
+  }
+  return label(lower) + "m+";
+}
+
+std::map<std::string, ClassSummary> summariseByRange(const MapReport& report,
+                                                     const std::map<int, double>& ranges,
+                                                     const std::vector<double>& edges) {
+  std::map<std::string, ClassSummary> out;
+  std::map<std::string, std::vector<std::vector<ShapeError>>> errors;
+  for (const TruthResult& r : report.truths) {
+    const auto range = ranges.find(r.truth_id);
+    if (range == ranges.end())
+      continue;
+    const std::string key = r.quadric_class + " " + rangeBand(range->second, edges);
+    ClassSummary& s = out[key];
+    ++s.truths;
+    s.duplicates += static_cast<int>(r.duplicate_ids.size());
+    if (r.matched) {
+      ++s.matched;
+      errors[key].push_back(r.errors);
+    } else {
+      ++s.misses;
+    }
+  }
+  for (auto& [key, list] : errors) {
+    std::vector<ShapeError>& mean = out[key].mean_errors;
+    mean = list.front();
+    for (std::size_t i = 0; i < mean.size(); ++i) {
+      double sum = 0.0;
+      for (const std::vector<ShapeError>& e : list)
+        sum += e[i].value;
+      mean[i].value = sum / static_cast<double>(list.size());
+    }
+  }
+  return out;
+}
+
+std::string formatMapReport(const MapReport& report,
+                            const std::map<std::string, ClassSummary>* by_range) {
   std::ostringstream out;
   char number[64];
   auto fmt = [&](double v) {
@@ -298,6 +386,15 @@ std::string formatMapReport(const MapReport& report) {
     for (const ShapeError& e : s.mean_errors)
       out << " mean_" << e.name << " " << fmt(e.value);
     out << "\n";
+  }
+  if (by_range) {
+    for (const auto& [key, s] : *by_range) {
+      out << "class_range " << key << " truths " << s.truths << " matched " << s.matched
+          << " misses " << s.misses << " duplicates " << s.duplicates;
+      for (const ShapeError& e : s.mean_errors)
+        out << " mean_" << e.name << " " << fmt(e.value);
+      out << "\n";
+    }
   }
   out << "map_summary matched " << report.matched << " misses " << report.misses << " duplicates "
       << report.duplicates << " unmatched_estimates " << report.unmatched_estimates;

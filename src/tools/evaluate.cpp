@@ -1,13 +1,16 @@
 // Trajectory (and map) evaluation against ground truth, as TUM's evaluate_ate.py / evaluate_rpe.py.
 //   evaluate --gt GT --est EST [--map MAP --quadrics-gt QGT] [--max-difference 0.02] [--delta 1.0]
 // Prints `ate_rmse_m X`, `pairs N`, `rpe_m_per_s X` (plus a few more statistics) and, with maps,
-// one line per true primitive, one per class and a `map_summary ...` line. Exit 1 on bad input.
+// one line per true primitive, one per class, one per class and range band (`class_range plane 0-2m
+// ...`: each true surface's median distance from the true camera path, bands 0-2, 2-4, 4+ m) and a
+// `map_summary ...` line. Exit 1 on bad input.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "quadric_slam/eval/map_metrics.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
@@ -117,7 +120,13 @@ int main(int argc, char** argv) {
       const quadric_slam::MapFile truth_map = quadric_slam::readMapYaml(quadrics_gt_path);
       const quadric_slam::MapReport report =
           quadric_slam::MapEvaluator().evaluate(truth_map, estimate_map, ate.T_gt_est);
-      std::fputs(quadric_slam::formatMapReport(report).c_str(), stdout);
+      // Accuracy per range band: each true surface's median distance from the true camera path.
+      std::vector<Eigen::Vector3d> camera_positions;
+      for (const auto& pose : gt)
+        camera_positions.push_back(pose.T_world_sensor.translation());
+      const auto by_range = quadric_slam::summariseByRange(
+          report, quadric_slam::truthRanges(truth_map, camera_positions), {2.0, 4.0});
+      std::fputs(quadric_slam::formatMapReport(report, &by_range).c_str(), stdout);
     }
   } catch (const std::exception& e) {
     std::cerr << "evaluate: " << e.what() << "\n";

@@ -98,8 +98,28 @@ class MapEvaluator {
   Params params_;
 };
 
-// Human-readable report: one line per true primitive, one per class, and a final summary line
+// --- Accuracy by range: near surfaces are measured better than far ones (the sensor's noise
+// grows with the square of depth), so a map's errors are also reported per band of range.
+//
+// A true primitive's range: the median over the camera positions (truth frame) of the distance
+// from the camera to its surface (plane: perpendicular; sphere, cylinder: exact; cone: to the
+// nearest of its lines in the camera's axial plane). Keyed by truth id; classes not evaluated are
+// left out. Throws std::invalid_argument when there are no camera positions.
+std::map<int, double> truthRanges(const MapFile& truth,
+                                  const std::vector<Eigen::Vector3d>& camera_positions);
+// The band a range falls in, for ascending edges (m): "0-2m", "2-4m", "4m+" for {2, 4}.
+std::string rangeBand(double range_m, const std::vector<double>& edges);
+// Per "<class> <band>" summaries of the report's truths (their matches, misses, duplicates and
+// mean errors); truths without a range are left out; unmatched estimates belong to no truth and
+// are not counted here.
+std::map<std::string, ClassSummary> summariseByRange(const MapReport& report,
+                                                     const std::map<int, double>& ranges,
+                                                     const std::vector<double>& edges);
+
+// Human-readable report: one line per true primitive, one per class, one per class and range band
+// (when by_range is given: "class_range plane 0-2m truths N ..."), and a final summary line
 // "map_summary matched N misses N duplicates N unmatched_estimates N".
-std::string formatMapReport(const MapReport& report);
+std::string formatMapReport(const MapReport& report,
+                            const std::map<std::string, ClassSummary>* by_range = nullptr);
 
 }  // namespace quadric_slam

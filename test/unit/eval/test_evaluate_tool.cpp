@@ -105,6 +105,9 @@ TEST(EvaluateTool, RigidlyMovedTrajectoryAndMap) {
   EXPECT_NE(ok.out.find("map_summary matched 1 misses 1 duplicates 0 unmatched_estimates 0"),
             std::string::npos)
       << ok.out;
+  // One line per class and range band of the true surfaces (their distance from the true path).
+  EXPECT_NE(ok.out.find("class_range sphere "), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("class_range plane "), std::string::npos) << ok.out;
 
   const ToolRun missing = runTool("--gt " + (dir / "gt.txt").string());
   EXPECT_EQ(missing.exit_code, 1);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "quadric_slam/eval/map_metrics.h"
 
@@ -168,6 +169,56 @@ TEST(MapMetrics, HandMadeMapsWithKnownErrors) {
       MapEvaluator().evaluate(truth, estimate, Eigen::Isometry3d::Identity());
   EXPECT_EQ(unaligned.matched, 0);
   EXPECT_EQ(unaligned.misses, 5);
+}
+
+// Range bands: a surface's range is its median distance from the camera positions; the summary per
+// class and band counts matches and misses of the truths in that band only.
+TEST(MapMetrics, RangesAndBandsFollowTheCameraPath) {
+  MapFile truth;
+  truth.quadrics.push_back(quadric(1, "plane", {{"normal", {0, 0, 1}}, {"offset", {0.0}}}));
+  truth.quadrics.push_back(quadric(2, "plane", {{"normal", {1, 0, 0}}, {"offset", {3.0}}}));
+  truth.quadrics.push_back(
+      quadric(3, "sphere", {{"center", {0.5, 0, 1.0}}, {"radius", {0.2}}}));
+  truth.quadrics.push_back(quadric(
+      4, "cylinder", {{"point", {-2.0, 0, 0}}, {"axis", {0, 0, 1}}, {"radius", {0.5}}}));
+  truth.quadrics.push_back(quadric(
+      5, "cone", {{"apex", {0, 0, 3.0}}, {"axis", {0, 0, 1}}, {"half_angle", {M_PI / 4}}}));
+  // Cameras at 1.5 m height along x in [-0.5, 0.5]: the median camera is (0, 0, 1.5).
+  std::vector<Eigen::Vector3d> cameras;
+  for (int i = 0; i <= 10; ++i)
+    cameras.emplace_back(-0.5 + 0.1 * i, 0.0, 1.5);
+  const std::map<int, double> ranges = quadric_slam::truthRanges(truth, cameras);
+  ASSERT_EQ(ranges.size(), 5u);
+  EXPECT_NEAR(ranges.at(1), 1.5, 1e-9);                              // floor below
+  EXPECT_NEAR(ranges.at(2), 3.0, 1e-9);                              // wall x = 3 (median x 0)
+  EXPECT_NEAR(ranges.at(3), std::hypot(0.5, 0.5) - 0.2, 1e-9);       // sphere from (0, 0, 1.5)
+  EXPECT_NEAR(ranges.at(4), 2.0 - 0.5, 1e-9);                        // cylinder axis at x = -2
+  // The cone's axis crosses the camera path: from (x, 0, 1.5) (radial |x|, axial 1.5 below the
+  // apex) the distance to the 45-degree line is (1.5 - |x|) sin 45; the median |x| is 0.3.
+  EXPECT_NEAR(ranges.at(5), (1.5 - 0.3) * std::sin(M_PI / 4), 1e-9);
+  EXPECT_THROW(quadric_slam::truthRanges(truth, {}), std::invalid_argument);
+
+  EXPECT_EQ(quadric_slam::rangeBand(1.5, {2.0, 4.0}), "0-2m");
+  EXPECT_EQ(quadric_slam::rangeBand(3.0, {2.0, 4.0}), "2-4m");
+  EXPECT_EQ(quadric_slam::rangeBand(4.5, {2.0, 4.0}), "4m+");
+
+  // An estimate of the floor only (2 cm off): the near plane band has a match, the far one a miss.
+  MapFile estimate;
+  estimate.quadrics.push_back(quadric(7, "plane", {{"normal", {0, 0, 1}}, {"offset", {0.02}}}));
+  const MapReport report = MapEvaluator().evaluate(truth, estimate, Eigen::Isometry3d::Identity());
+  const auto by_range = quadric_slam::summariseByRange(report, ranges, {2.0, 4.0});
+  ASSERT_EQ(by_range.count("plane 0-2m"), 1u);
+  ASSERT_EQ(by_range.count("plane 2-4m"), 1u);
+  EXPECT_EQ(by_range.at("plane 0-2m").matched, 1);
+  EXPECT_EQ(by_range.at("plane 0-2m").misses, 0);
+  EXPECT_NEAR(by_range.at("plane 0-2m").mean_errors.at(1).value, 0.02, 1e-9);  // offset_m
+  EXPECT_EQ(by_range.at("plane 2-4m").matched, 0);
+  EXPECT_EQ(by_range.at("plane 2-4m").misses, 1);
+  EXPECT_EQ(by_range.at("sphere 0-2m").misses, 1);
+  const std::string text = quadric_slam::formatMapReport(report, &by_range);
+  EXPECT_NE(text.find("class_range plane 0-2m truths 1 matched 1 misses 0 duplicates 0"),
+            std::string::npos)
+      << text;
 }
 
 TEST(MapMetrics, BadInputNamesTheProblem) {
