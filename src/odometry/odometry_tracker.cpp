@@ -64,7 +64,7 @@ OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_
   out.consecutive_lost = consecutive_lost_;
   // Left perturbation exp(xi^) T: t_true = t + v + omega x t, so (dt, r) = [I -[t]x; 0 I] xi.
   Matrix6 M = Matrix6::Identity();
-  M.topRightCorner<3, 3>() = -pose_math::skew(T_odom_camera_.translation());
+  M.topRightCorner<3, 3>() = -skew(T_odom_camera_.translation());
   out.covariance = M * covariance_ * M.transpose();
   return out;
 }
@@ -181,7 +181,7 @@ OdometryTracker::Result OdometryTracker::track(
     T_odom_camera_ = pose_math::orthonormalized(T_odom_keyframe_ * icp.T_reference_current);
     // First-order composition: T_odom_cur = exp(a) T_odom_kf exp(b) T_kf_cur
     //                                     = exp(a + Ad(T_odom_kf) b) T_odom_cur.
-    const Matrix6 ad = pose_math::adjoint(T_odom_keyframe_);
+    const Matrix6 ad = adjointSE3(T_odom_keyframe_);
     covariance_ = keyframe_covariance_ + ad * icp.covariance * ad.transpose();
     // Only a step constrained in all six directions and accepted by the data sets the velocity;
     // along a degenerate direction the motion is the prior's, which must not feed itself.

@@ -18,7 +18,7 @@ namespace quadric_slam {
 class OdometryTracker {
  public:
   using Cloud = PointToPlaneIcp::Cloud;
-  using Matrix6 = pose_math::Matrix6;
+  using Matrix6 = Matrix6d;
 
   struct Params {
     PointToPlaneIcp::Params icp;

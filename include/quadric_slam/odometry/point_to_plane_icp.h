@@ -32,8 +32,8 @@ int organizedCloudDecimation(const CameraIntrinsics& intrinsics, int cloud_width
 class PointToPlaneIcp {
  public:
   using Cloud = pcl::PointCloud<pcl::PointNormal>;
-  using Matrix6 = pose_math::Matrix6;
-  using Vector6 = pose_math::Vector6;
+  using Matrix6 = Matrix6d;
+  using Vector6 = Vector6d;
 
   struct Params {
     // Pyramid levels; level l samples every (finest_stride * 2^l)-th point of the current cloud in

@@ -127,7 +127,7 @@ TEST_F(IcpOnRoom, RecoversKnownRigidMotion) {
   // Covariance: symmetric positive definite with sub-millimetre standard deviations, and the
   // actual error within four of them.
   EXPECT_TRUE(r.covariance.isApprox(r.covariance.transpose()));
-  Eigen::SelfAdjointEigenSolver<pose_math::Matrix6> eig(r.covariance);
+  Eigen::SelfAdjointEigenSolver<Matrix6d> eig(r.covariance);
   EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
   EXPECT_LT(std::sqrt(r.covariance.diagonal().head<3>().maxCoeff()), 1e-3);
   const Eigen::Vector3d position_error = r.T_reference_current.translation() - T_a_b.translation();
