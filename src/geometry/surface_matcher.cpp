@@ -31,6 +31,23 @@ Eigen::Matrix3d kabsch(const std::vector<Eigen::Vector3d>& u, const std::vector<
   return svd.matrixV() * D * svd.matrixU().transpose();
 }
 
+// The rotation taking the columns of U onto those of V (Kabsch with unit weights): the hypotheses'
+// case of two directions and their cross product, without the vectors of the general one.
+Eigen::Matrix3d kabsch(const Eigen::Matrix3d& U, const Eigen::Matrix3d& V) {
+  const Eigen::Matrix3d H = U * V.transpose();
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+  return svd.matrixV() * D * svd.matrixU().transpose();
+}
+
+// Two directions and their cross product as the columns of a frame.
+Eigen::Matrix3d directionFrame(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  Eigen::Matrix3d M;
+  M << a, b, a.cross(b).normalized();
+  return M;
+}
+
 // A direction that can define a rotation: a plane normal, or one of the two signs of a cylinder's
 // or cone's axis (the fit does not fix a cylinder's sign; a cone's quadric is the double cone, and
 // which nappe its frame names may differ between a frame and the map).
@@ -74,7 +91,12 @@ class Hypotheses {
   Hypotheses(const SurfaceMatcher::Params& params, const std::vector<MatchableSurface>& reference,
              const std::vector<MatchableSurface>& current, const SurfaceMatcher::PairTest& test,
              const MotionPrior* prior)
-      : p_(params), ref_(reference), cur_(current), test_(test), prior_(prior) {}
+      : p_(params),
+        ref_(reference),
+        cur_(current),
+        test_(test),
+        prior_(prior),
+        cos_max_angle_(std::cos(params.max_angle_difference)) {}
 
   bool sameShape(const MatchableSurface& c, const MatchableSurface& r) const {
     if (c.kind != r.kind)
@@ -93,11 +115,10 @@ class Hypotheses {
       return false;
     if (c.kind == Kind::kSphere)
       return true;
-    const Eigen::Vector3d d = R * c.direction;
-    const double angle = axial(c.kind)
-                             ? std::acos(std::min(1.0, std::abs(d.dot(r.direction))))
-                             : angleBetween(d, r.direction);
-    return angle <= p_.max_angle_difference;
+    // Within max_angle_difference, compared by cosines (unit directions; this runs for every pair
+    // of surfaces under every rotation).
+    const double cosine = (R * c.direction).dot(r.direction);
+    return (axial(c.kind) ? std::abs(cosine) : cosine) >= cos_max_angle_;
   }
 
   // Adds the linear constraints on t of a pair (weight w) to the normal equations.
@@ -232,6 +253,7 @@ class Hypotheses {
   const std::vector<MatchableSurface>& cur_;
   const SurfaceMatcher::PairTest& test_;
   const MotionPrior* prior_;  // may be null
+  double cos_max_angle_;
 };
 
 std::vector<SurfaceAlignment> Hypotheses::run() const {
@@ -250,13 +272,31 @@ std::vector<SurfaceAlignment> Hypotheses::run() const {
     std::vector<Eigen::Vector3d> lines;  // a point of each tried line (the one solve() picks)
   };
   std::vector<TriedRotation> tried;
+  // Rotations closer than half the angle tolerance count as one: angularDistance(q, q') =
+  // 2 acos(|q.q'|), compared through the cosine (this runs for every hypothesis and every rotation
+  // tried before it).
+  const double cos_same_rotation = std::cos(0.25 * p_.max_angle_difference);
   const auto rotationEntry = [&](const Eigen::Matrix3d& R) -> TriedRotation& {
     const Eigen::Quaterniond q(R);
     for (TriedRotation& other : tried)
-      if (q.angularDistance(other.q) < 0.5 * p_.max_angle_difference)
+      if (std::abs(q.dot(other.q)) > cos_same_rotation)
         return other;
     tried.push_back({q, candidatesUnder(R), {}});
     return tried.back();
+  };
+  // The angles between reference directions, once (the loops below visit each pair many times).
+  const std::size_t n_ref = ref_dirs.size();
+  std::vector<double> ref_angle(n_ref * n_ref);
+  for (std::size_t i = 0; i < n_ref; ++i)
+    for (std::size_t j = 0; j < n_ref; ++j)
+      ref_angle[i * n_ref + j] = angleBetween(ref_dirs[i].direction, ref_dirs[j].direction);
+  // With a prior, a current direction can only be matched to a reference direction within the
+  // prior's rotation bound (plus the matching tolerance) of where the prior rotation puts it.
+  const double cos_prior_reach =
+      prior_ ? std::cos(std::min(M_PI, prior_->max_rotation + p_.max_angle_difference)) : -1.0;
+  const auto reachable = [&](const DirectionFeature& c, const DirectionFeature& r) {
+    return !prior_ || (prior_->T_reference_current.linear() * c.direction).dot(r.direction) >=
+                          cos_prior_reach;
   };
   for (std::size_t a = 0; a < cur_dirs.size(); ++a) {
     for (std::size_t b = a + 1; b < cur_dirs.size(); ++b) {
@@ -267,20 +307,21 @@ std::vector<SurfaceAlignment> Hypotheses::run() const {
       const double cur_angle = angleBetween(ca.direction, cb.direction);
       if (cur_angle < p_.min_pair_angle || cur_angle > M_PI - p_.min_pair_angle)
         continue;
-      for (const DirectionFeature& ra : ref_dirs) {
-        if (!sameShape(cur_[ca.surface], ref_[ra.surface]))
+      const Eigen::Matrix3d cur_frame = directionFrame(ca.direction, cb.direction);
+      for (std::size_t i = 0; i < n_ref; ++i) {
+        const DirectionFeature& ra = ref_dirs[i];
+        if (!sameShape(cur_[ca.surface], ref_[ra.surface]) || !reachable(ca, ra))
           continue;
-        for (const DirectionFeature& rb : ref_dirs) {
+        for (std::size_t j = 0; j < n_ref; ++j) {
+          const DirectionFeature& rb = ref_dirs[j];
           if (ref_[rb.surface].source == ref_[ra.surface].source ||
               !sameShape(cur_[cb.surface], ref_[rb.surface]))
             continue;
-          if (std::abs(angleBetween(ra.direction, rb.direction) - cur_angle) >
-              p_.max_angle_difference)
+          if (std::abs(ref_angle[i * n_ref + j] - cur_angle) > p_.max_angle_difference ||
+              !reachable(cb, rb))
             continue;
           const Eigen::Matrix3d R =
-              kabsch({ca.direction, cb.direction, ca.direction.cross(cb.direction).normalized()},
-                     {ra.direction, rb.direction, ra.direction.cross(rb.direction).normalized()},
-                     {1.0, 1.0, 1.0});
+              kabsch(cur_frame, directionFrame(ra.direction, rb.direction));
           if (!withinPrior(R))
             continue;
           TriedRotation& entry = rotationEntry(R);
