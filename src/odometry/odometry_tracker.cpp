@@ -26,6 +26,8 @@ void OdometryTracker::Params::validate() const {
     fail("guess_min_translation", "(0, inf) m", guess_min_translation);
   if (!(guess_min_rotation > 0 && guess_min_rotation <= M_PI))
     fail("guess_min_rotation", "(0, pi] rad", guess_min_rotation);
+  if (!(guess_skip_inlier_fraction > 0 && guess_skip_inlier_fraction <= 1))
+    fail("guess_skip_inlier_fraction", "(0, 1]", guess_skip_inlier_fraction);
   guess.validate();
 }
 
@@ -111,6 +113,11 @@ PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
   }
   if (!params_.quadric_motion_guess || !observations || keyframe_observations_.empty())
     return best;
+  if (best.status == TrackingStatus::kOk &&
+      best.inlier_fraction >= params_.guess_skip_inlier_fraction) {
+    out.guess.message = "not needed: ICP from the prior is ok with enough inliers";
+    return best;
+  }
   out.guess = guesser_.guess(keyframe_observations_, *observations, T_keyframe_prior);
   if (!out.guess.found || !startsElsewhere(T_keyframe_prior, out.guess.T_reference_current))
     return best;  // the prior already starts where the surfaces say

@@ -46,6 +46,7 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "lost_frames_before_new_keyframe", params.lost_frames_before_new_keyframe, log);
   readParam(reader, "quadric_motion_guess", params.quadric_motion_guess, log);
   readParam(reader, "guess_min_translation", params.guess_min_translation, log);
+  readParam(reader, "guess_skip_inlier_fraction", params.guess_skip_inlier_fraction, log);
   readParam(reader, "guess_min_rotation", params.guess_min_rotation, log);
   QuadricMotionGuesser::Params& guess = params.guess;
   readParam(reader, "guess_max_angle_difference", guess.max_angle_difference, log);
