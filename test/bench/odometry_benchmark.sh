@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Odometry benchmark: our pipeline (odometry only, and full SLAM) against Open3D on full-length
-# synthetic desk sequences driven by the real TUM fr1_desk, fr1_xyz, fr1_room ... motion-capture
-# trajectories, at full rate and sub-sampled (every Nth frame: large steps between frames), and
+# synthetic sequences driven by the real TUM fr1_desk, fr1_xyz, fr1_room ... motion-capture
+# trajectories (the desk scene; fr1_room in config/scenes/room_fr1.yaml, a room around its path), at full rate and sub-sampled (every Nth frame: large steps between frames), and
 # optionally on the real 7-Scenes kitchen.
 #
 #   test/bench/odometry_benchmark.sh [--out DIR] [--seconds S] [--sequences "fr1_desk fr1_xyz"]
@@ -262,6 +262,15 @@ rate_dir() {  # base_dir rate -> the folder to read (the base itself at rate 1)
 
 [ -n "$o3d_rates" ] || o3d_rates=$rates
 load_before=$(uptime)
+# The scene a trajectory is rendered in: fr1_room walks around a whole room (config/scenes/
+# room_fr1.yaml surrounds its path); the other trajectories look at a desk (desk.yaml).
+scene_for() {
+  case "$1" in
+    fr1_room) echo "$QS_ROOT/config/scenes/room_fr1.yaml" ;;
+    *) echo "$QS_ROOT/config/scenes/desk.yaml" ;;
+  esac
+}
+
 if [ "$synthetic" -eq 1 ]; then
   for seq in $sequences; do
     gt_file="$gt_dir/rgbd_dataset_${seq/fr/freiburg}-groundtruth.txt"
@@ -270,7 +279,8 @@ if [ "$synthetic" -eq 1 ]; then
     if [ "$regenerate" -eq 1 ] || [ ! -f "$base/depth.txt" ] || [ ! -f "$base/groundtruth.txt" ]; then
       rm -rf "$base"
       echo "== $seq: rendering $seconds s along $(basename "$gt_file"), depth model $depth_model" >&2
-      "$QS_ROOT/scripts/synth" --out "$base" --trajectory "$gt_file" --seconds "$seconds" \
+      "$QS_ROOT/scripts/synth" --out "$base" --scene "$(scene_for "$seq")" \
+        --trajectory "$gt_file" --seconds "$seconds" \
         --no-bag --no-labels --name "$seq" --depth-model "$depth_model" --threads "$QS_JOBS" \
         >"$out/$seq.synth.log" 2>&1
     fi
@@ -306,7 +316,7 @@ import sys
 rows_path, md_path, before, after, cores, depth_model = sys.argv[1:]
 rows = [l.rstrip("\n").split("\t") for l in open(rows_path) if l.strip()]
 lines = [
-    "# Odometry benchmark (frame-to-keyframe / frame-to-frame; synthetic desk scene moved along "
+    "# Odometry benchmark (frame-to-keyframe / frame-to-frame; synthetic scenes (the desk; fr1_room in a room around its path) along "
     "real TUM trajectories, depth model %s; the real 7-Scenes kitchen)" % depth_model,
     "",
     "Machine: %s cores, shared. Load at start: `%s`. Load at end: `%s`." % (cores, before.strip(), after.strip()),
