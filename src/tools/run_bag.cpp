@@ -226,6 +226,7 @@ std::vector<qs::QuadricLandmark> refineOffline(const qs::QuadricSlam& slam, std:
       s.skipped_observations);
   std::printf("batch_seconds %.3f\nbatch_solve_seconds %.3f\nbatch_covariance_seconds %.3f\n",
               seconds, s.solve_seconds, s.covariance_seconds);
+  std::printf("batch_report %s\n", s.report.c_str());
   if (!s.solution_usable) {
     std::printf("batch_refinement not usable (%s): the online estimates are kept\n",
                 s.report.c_str());

@@ -1,9 +1,10 @@
-// BatchRefiner on a synthetic world with known truth (synthetic_world.h: the room's planes,
+// BatchRefiner on a synthetic world with known truth (synthetic_world.h: a corridor of planes,
 // spheres, cylinders and cones; measurement noise 5 mm / 0.005 rad / 2% of scale; odometry with a
 // 2% scale error and a 1 mrad-per-frame yaw bias): after the online mapper has run, recorded by a
 // BatchRecorder, the one global dog-leg solve brings the trajectory closer to the truth than the
 // online sliding window, the landmarks converge to the true surfaces, the first keyframe (the
 // gauge) stays where it was and every frame hangs from its refined keyframe through its odometry.
+// The solve finds the optimum of the whole problem whatever online path led to its start.
 #include <gtest/gtest.h>
 
 #include <iostream>
@@ -98,13 +99,14 @@ TEST(BatchRefiner, EmptyRecordingGivesAnEmptyUnusableSolution) {
   EXPECT_TRUE(s.keyframe_poses.empty());
 }
 
-// One and a half laps around the room (the second half re-observes the first landmarks, which the
-// window has long marginalised).
+// A corridor with a new object every metre (planes, spheres, cylinders, cones) and drifting
+// odometry: each pose was estimated online from landmarks known only from the frames before it;
+// the batch also uses every later observation of them (a smoother rather than a filter).
 TEST(BatchRefiner, RefinedTrajectoryBeatsTheOnlineWindowAndLandmarksConverge) {
-  const std::vector<test::TrueLandmark> world = test::roomWorld();
-  const std::vector<Eigen::Isometry3d> poses = test::circleTrajectory(300, 1.5);
+  const std::vector<test::TrueLandmark> world = test::corridorWorld(20);
+  const std::vector<Eigen::Isometry3d> poses = test::corridorTrajectory(700);
   QuadricMapper mapper;
-  const RecordedRun run = runAndRecord(&mapper, world, poses, 101);
+  const RecordedRun run = runAndRecord(&mapper, world, poses, 102);
   const BatchRecorder& recorder = run.recorder;
   ASSERT_EQ(recorder.frames().size(), poses.size());
   ASSERT_EQ(static_cast<int>(recorder.keyframes().size()), run.keyframes);
@@ -113,7 +115,7 @@ TEST(BatchRefiner, RefinedTrajectoryBeatsTheOnlineWindowAndLandmarksConverge) {
   const BatchStatistics& s = solution.statistics;
   std::cout << "batch: " << s.keyframes << " keyframes, " << s.landmarks << " landmarks, "
             << s.observation_factors << " observations, " << s.iterations << " iterations, cost "
-            << s.initial_cost << " -> " << s.final_cost << "\n";
+            << s.initial_cost << " -> " << s.final_cost << " (" << s.report << ")\n";
   ASSERT_TRUE(s.solution_usable) << s.report;
   EXPECT_EQ(s.keyframes, run.keyframes);
   EXPECT_EQ(s.frames, static_cast<int>(poses.size()));
@@ -152,36 +154,73 @@ TEST(BatchRefiner, RefinedTrajectoryBeatsTheOnlineWindowAndLandmarksConverge) {
   const AteResult refined_ate = ate.evaluate(run.truth, refined);
   std::cout << "ATE RMSE odometry " << odometry_ate << " m, online " << online_ate << " m, refined "
             << refined_ate.rmse() << " m\n";
-  // Measurement noise alone leaves about 1 cm (see test_quadric_mapper); the online window
-  // reaches 1.4-2.8 cm against the odometry's 27-30 cm.
-  EXPECT_LT(refined_ate.rmse(), 0.8 * online_ate);
-  EXPECT_LT(refined_ate.rmse(), 0.015);
+  // Seeds 101-103: odometry 50-52 cm, online 8.2-9.6 mm, refined 6.8-8.3 mm (0.84-0.86 of the
+  // online ATE; with a window of 3 keyframes the same).
+  EXPECT_LT(refined_ate.rmse(), 0.9 * online_ate);
+  EXPECT_LT(refined_ate.rmse(), 0.03 * odometry_ate);
 
-  // The map, refined and online, against the true surfaces in the ATE-aligned frame.
+  // The map, refined and online, against the true surfaces in the map frame (the first camera
+  // pose: the gauge; the position-only ATE alignment of a nearly straight path leaves the roll
+  // about it free, which would tilt every surface alike).
   const MapEvaluator evaluator;
   const MapReport refined_map =
-      evaluator.evaluate(truthMap(world), estimateMap(solution.landmarks), refined_ate.T_gt_est);
-  const MapReport online_map = evaluator.evaluate(truthMap(world), estimateMap(mapper.landmarks()),
-                                                  ate.evaluate(run.truth, run.online).T_gt_est);
+      evaluator.evaluate(truthMap(world), estimateMap(solution.landmarks), poses[0]);
+  const MapReport online_map =
+      evaluator.evaluate(truthMap(world), estimateMap(mapper.landmarks()), poses[0]);
   std::cout << "refined map:\n"
             << formatMapReport(refined_map) << "online map:\n"
             << formatMapReport(online_map);
   EXPECT_EQ(refined_map.matched, static_cast<int>(world.size()));
   EXPECT_EQ(refined_map.duplicates, 0);
   EXPECT_EQ(refined_map.unmatched_estimates, 0);
-  EXPECT_LT(meanError(refined_map, "plane", "normal_angle_deg"), 0.3);
-  EXPECT_LT(meanError(refined_map, "plane", "offset_m"), 0.01);
-  EXPECT_LT(meanError(refined_map, "sphere", "center_m"), 0.02);
-  EXPECT_LT(meanError(refined_map, "sphere", "radius_m"), 0.004);
+  // Seed 102: refined plane normals 0.24 deg / offsets 2.1 mm, sphere centres 1.9 cm / radii
+  // 0.4 mm, cylinder axes 0.20 deg / 2.0 cm / radii 0.5 mm, cone apices 2.0 cm / axes 0.20 deg /
+  // half-angles 0.05 deg (the positions drift along the corridor with the odometry's scale error,
+  // which no surface in view can observe).
+  EXPECT_LT(meanError(refined_map, "plane", "normal_angle_deg"), 0.35);
+  EXPECT_LT(meanError(refined_map, "plane", "offset_m"), 0.005);
+  EXPECT_LT(meanError(refined_map, "sphere", "center_m"), 0.03);
+  EXPECT_LT(meanError(refined_map, "sphere", "radius_m"), 0.001);
   EXPECT_LT(meanError(refined_map, "cylinder", "axis_angle_deg"), 0.3);
-  EXPECT_LT(meanError(refined_map, "cylinder", "axis_distance_m"), 0.02);
-  EXPECT_LT(meanError(refined_map, "cylinder", "radius_m"), 0.004);
+  EXPECT_LT(meanError(refined_map, "cylinder", "axis_distance_m"), 0.03);
+  EXPECT_LT(meanError(refined_map, "cylinder", "radius_m"), 0.001);
   EXPECT_LT(meanError(refined_map, "cone", "apex_m"), 0.03);
   EXPECT_LT(meanError(refined_map, "cone", "axis_angle_deg"), 0.3);
-  EXPECT_LT(meanError(refined_map, "cone", "half_angle_deg"), 0.3);
+  EXPECT_LT(meanError(refined_map, "cone", "half_angle_deg"), 0.1);
+  // Where the surfaces are is better known after the batch than online (online, seed 102: plane
+  // offsets 8.3 mm, sphere centres 2.4 cm, cylinder axes 2.6 cm, cone apices 2.5 cm).
+  for (const auto& [quadric_class, position] :
+       std::vector<std::pair<std::string, std::string>>{{"plane", "offset_m"},
+                                                        {"sphere", "center_m"},
+                                                        {"cylinder", "axis_distance_m"},
+                                                        {"cone", "apex_m"}})
+    EXPECT_LT(meanError(refined_map, quadric_class, position),
+              meanError(online_map, quadric_class, position))
+        << quadric_class;
   // Refined covariances: one per landmark, of its class's minimal size.
   for (const QuadricLandmark& l : solution.landmarks)
     EXPECT_EQ(l.covariance.rows(), minimalDimension(l.quadric_map.quadricClass())) << l.id;
+}
+
+// The batch is the whole problem's optimum, not a function of the online estimation: mapped
+// with a window of 10 or of 3 keyframes (other online estimates, the same recorded factors when
+// the keyframes agree), it ends at the same cost.
+TEST(BatchRefiner, EndsAtTheSameOptimumFromDifferentOnlineWindows) {
+  const std::vector<test::TrueLandmark> world = test::corridorWorld(20);
+  const std::vector<Eigen::Isometry3d> poses = test::corridorTrajectory(700);
+  std::vector<BatchStatistics> stats;
+  for (int size : {10, 3}) {
+    QuadricMapper::Params params;
+    params.window.size = size;
+    QuadricMapper mapper(params);
+    const RecordedRun run = runAndRecord(&mapper, world, poses, 101);
+    stats.push_back(BatchRefiner().refine(run.recorder, mapper).statistics);
+    ASSERT_TRUE(stats.back().solution_usable);
+  }
+  ASSERT_EQ(stats[0].keyframes, stats[1].keyframes) << "other keyframes: not the same problem";
+  ASSERT_EQ(stats[0].observation_factors, stats[1].observation_factors);
+  EXPECT_NE(stats[0].initial_cost, stats[1].initial_cost);  // the online estimates differ
+  EXPECT_NEAR(stats[0].final_cost, stats[1].final_cost, 1e-5 * stats[0].final_cost);
 }
 
 }  // namespace
