@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <map>
@@ -132,6 +133,7 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
 
   // Landmarks and every keyframe observation of them.
   std::map<int, QuadricBlock> landmarks;
+  std::vector<ceres::ResidualBlockId> observation_blocks;
   for (std::size_t i = 0; i < keyframes.size(); ++i) {
     for (const WindowObservation& observation : keyframes[i].observations) {
       const int id = observation.landmark_id;
@@ -153,10 +155,10 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
           ++stats.fixed_landmarks;
         }
       }
-      problem.AddResidualBlock(
+      observation_blocks.push_back(problem.AddResidualBlock(
           QuadricObservationCost::Create(observation.measurement.quadric_camera,
                                          observation.measurement.covariance),
-          huber.get(), poses[i].data(), it->second.data());
+          huber.get(), poses[i].data(), it->second.data()));
       ++stats.observation_factors;
     }
   }
@@ -186,6 +188,18 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
 
   for (std::size_t i = 0; i < keyframes.size(); ++i)
     solution.keyframe_poses[i] = poseFromParameters(poses[i].data());
+  std::vector<double> norms;
+  for (ceres::ResidualBlockId id : observation_blocks) {
+    Eigen::VectorXd r(problem.GetCostFunctionForResidualBlock(id)->num_residuals());
+    double cost = 0.0;
+    if (problem.EvaluateResidualBlock(id, false, &cost, r.data(), nullptr))
+      norms.push_back(r.norm());
+  }
+  if (!norms.empty()) {
+    std::sort(norms.begin(), norms.end());
+    stats.observation_residual_median = norms[norms.size() / 2];
+    stats.observation_residual_p95 = norms[std::min(norms.size() - 1, norms.size() * 95 / 100)];
+  }
   std::vector<int> free_ids;
   for (const auto& [id, block] : landmarks)
     if (!fixed(id))

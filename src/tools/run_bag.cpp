@@ -227,6 +227,8 @@ std::vector<qs::QuadricLandmark> refineOffline(const qs::QuadricSlam& slam, std:
   std::printf("batch_seconds %.3f\nbatch_solve_seconds %.3f\nbatch_covariance_seconds %.3f\n",
               seconds, s.solve_seconds, s.covariance_seconds);
   std::printf("batch_report %s\n", s.report.c_str());
+  std::printf("batch observation residual (sigmas) median %.2f p95 %.2f\n",
+              s.observation_residual_median, s.observation_residual_p95);
   if (!s.solution_usable) {
     std::printf("batch_refinement not usable (%s): the online estimates are kept\n",
                 s.report.c_str());

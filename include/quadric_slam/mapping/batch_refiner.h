@@ -45,6 +45,9 @@ struct BatchStatistics {
   bool solution_usable = false;
   bool covariance_computed = false;  // false: the landmarks keep their online covariances
   std::string report;                // Ceres' one-line report
+  // Whitened observation residual norms at the solution (sigmas, before the robust loss): how
+  // well the measurement covariances describe the data (about sqrt(k) when they do).
+  double observation_residual_median = 0.0, observation_residual_p95 = 0.0;
   double solve_seconds = 0.0, covariance_seconds = 0.0;  // wall time
 };
 

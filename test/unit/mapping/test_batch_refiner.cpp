@@ -126,6 +126,13 @@ TEST(BatchRefiner, RefinedTrajectoryBeatsTheOnlineWindowAndLandmarksConverge) {
   EXPECT_EQ(s.invalid_landmarks, 0);
   EXPECT_TRUE(s.covariance_computed);
   EXPECT_LT(s.final_cost, s.initial_cost);
+  std::cout << "whitened observation residuals: median " << s.observation_residual_median
+            << " p95 " << s.observation_residual_p95 << "\n";
+  // The synthetic noise is what the covariances say: a k-dimensional whitened residual (k = 3-6)
+  // has a norm of about sqrt(k) at the optimum.
+  EXPECT_GT(s.observation_residual_median, 1.0);
+  EXPECT_LT(s.observation_residual_median, 3.0);
+  EXPECT_LT(s.observation_residual_p95, 5.0);
   ASSERT_EQ(solution.trajectory.size(), poses.size());
 
   // The gauge: the first keyframe (the map frame) does not move.
