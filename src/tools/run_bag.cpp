@@ -12,7 +12,7 @@
 //   DIR/trajectory_odom.txt  the odometry, camera optical frame in the odom frame
 //   DIR/timing.json          per-stage median/p95/max
 //   DIR/map.yaml             the landmarks (map schema), unless --odometry-only; refined by the
-//                            batch refinement when it ran
+//                            batch refinement when it ran (DIR/map_online.yaml: the online map)
 //   DIR/reconstruction.pcd   landmark points projected onto their surfaces (label = landmark id;
 //                            rgba = the pixel's colour when the input has RGB, alpha 255, else
 //                            the landmark's colour, alpha 0: ros/reconstruction_cloud.h)
@@ -409,8 +409,11 @@ int main(int argc, char** argv) {
           "left %zu, merged at save %zu, duplicate pairs saved %zu\n",
           joined, merged_online, duplicates_online, merged_at_save, duplicates_saved);
       std::vector<qs::QuadricLandmark> landmarks = slam.mapper().landmarks();
-      if (batch)
+      if (batch) {
+        qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"),
+                         o.out_dir + "/map_online.yaml");
         landmarks = refineOffline(slam, resets, o.out_dir);
+      }
       qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"), o.out_dir + "/map.yaml");
       std::map<std::string, int> per_class;
       for (const qs::QuadricLandmark& landmark : landmarks)
