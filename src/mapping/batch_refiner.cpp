@@ -59,6 +59,8 @@ std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
 void BatchRefiner::Params::validate() const {
   if (max_iterations < 1 || max_iterations > 10000)
     throw std::invalid_argument("BatchRefiner::Params::max_iterations must be in [1, 10000]");
+  if (max_keyframes < 1 || max_keyframes > 1000000)
+    throw std::invalid_argument("BatchRefiner::Params::max_keyframes must be in [1, 1000000]");
 }
 
 BatchRefiner::BatchRefiner(const Params& params) : params_(params) {
@@ -98,7 +100,10 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
     solution.keyframe_poses.push_back(keyframe.T_map_camera);
   for (const auto& [id, landmark] : map.landmarks())
     solution.landmarks.push_back(landmark);
-  if (keyframes.empty()) {
+  if (keyframes.empty() || stats.keyframes > params_.max_keyframes) {
+    if (!keyframes.empty())
+      stats.report = std::to_string(stats.keyframes) + " keyframes, more than max_keyframes " +
+                     std::to_string(params_.max_keyframes) + ": not solved";
     solution.trajectory = reattachFrames(recorder, solution.keyframe_poses);
     return solution;
   }

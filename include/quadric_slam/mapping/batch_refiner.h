@@ -68,6 +68,12 @@ class BatchRefiner {
   struct Params {
     // Dog-leg iterations, int in [1, 10000].
     int max_iterations = 100;
+    // A larger recording is not solved (refine() returns the online estimates, not usable) and
+    // QuadricSlam stops recording past it: the cost of an iteration grows up to cubically with the
+    // keyframes (surfaces seen from every keyframe, a floor, make the reduced camera system
+    // dense: 227 kitchen keyframes take 0.2 s an iteration), and the recording's memory with them.
+    // int in [1, 1000000].
+    int max_keyframes = 500;
     // Marginal covariances of the refined landmarks (ceres::Covariance over the whole problem);
     // false, or when they cannot be computed: the online covariances stay.
     bool compute_covariance = true;

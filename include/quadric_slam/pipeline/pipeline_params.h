@@ -45,7 +45,8 @@ void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Par
                                 ParamLog& log);
 
 // config/mapping.yaml, the offline batch refinement at the end of run_bag (never read by the
-// nodelets): batch_refinement (on/off), batch_max_iterations, batch_compute_covariance.
+// nodelets): batch_refinement (on/off), batch_max_iterations, batch_max_keyframes,
+// batch_compute_covariance.
 void readBatchRefinementParams(const ParamReader& reader, bool& enabled,
                                BatchRefiner::Params& params, ParamLog& log);
 

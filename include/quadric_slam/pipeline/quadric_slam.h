@@ -72,9 +72,9 @@ struct SlamParams {
 };
 
 // Reads config_dir/{normal_estimation,segmentation,odometry,mapping}.yaml through the key tables
-// the nodelets use (and mapping.yaml's batch_* keys, which only the offline runner uses); absent files keep the defaults of their stage. The effective values go to
-// *log when given. Throws std::runtime_error (unreadable file) or std::invalid_argument (bad
-// value).
+// the nodelets use (and mapping.yaml's batch_* keys, which only the offline runner uses); absent
+// files keep the defaults of their stage. The effective values go to *log when given. Throws
+// std::runtime_error (unreadable file) or std::invalid_argument (bad value).
 SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log = nullptr);
 
 struct SlamFrameResult {
@@ -107,7 +107,9 @@ class QuadricSlam {
   std::vector<LandmarkMerge> mergeDuplicateLandmarks();
   // With params().batch_refinement: one global solve over every keyframe and landmark since the
   // last reset (mapping/batch_refiner.h), the mapped frames re-attached to their keyframes. Leaves
-  // the online state as it is. Throws std::logic_error when batch_refinement is off.
+  // the online state as it is. A run of more than batch.max_keyframes keyframes is neither
+  // recorded nor solved (the solution is then empty and not usable, its report says why).
+  // Throws std::logic_error when batch_refinement is off.
   BatchSolution refineBatch() const;
   const BatchRecorder& batchRecorder() const { return batch_recorder_; }
 
@@ -135,6 +137,7 @@ class QuadricSlam {
   QuadricReconstruction reconstruction_;
   TrackingRecovery recovery_;
   BatchRecorder batch_recorder_;  // empty unless params_.batch_refinement
+  bool batch_overflow_ = false;   // more than batch.max_keyframes: recording stopped
   StageTimer timer_;
   bool has_stamp_ = false;
   double last_stamp_ = 0.0;

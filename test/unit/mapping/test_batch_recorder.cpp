@@ -109,6 +109,14 @@ TEST(BatchRecorder, ObservationsOfAMergedLandmarkGoToItsSurvivor) {
   EXPECT_EQ(static_cast<std::size_t>(solution.statistics.observation_factors),
             following.observations());
   EXPECT_EQ(refiner.refine(ignoring, mapper).statistics.skipped_observations, ignored.at(merged));
+  // A recording over max_keyframes is not solved: the online estimates come back, not usable.
+  BatchRefiner::Params small;
+  small.max_keyframes = static_cast<int>(following.keyframes().size()) - 1;
+  const BatchSolution refused = BatchRefiner(small).refine(following, mapper);
+  EXPECT_FALSE(refused.statistics.solution_usable);
+  EXPECT_NE(refused.statistics.report.find("max_keyframes"), std::string::npos);
+  ASSERT_EQ(refused.keyframe_poses.size(), following.keyframes().size());
+  EXPECT_TRUE(refused.keyframe_poses.back().isApprox(following.keyframes().back().T_map_camera));
 
   // Merges made outside process() (the whole-map merge before saving) are followed the same way.
   BatchRecorder later = ignoring;

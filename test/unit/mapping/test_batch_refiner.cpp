@@ -79,6 +79,9 @@ double meanError(const MapReport& report, const std::string& quadric_class,
 TEST(BatchRefiner, ParamsValidate) {
   BatchRefiner::Params p;
   EXPECT_NO_THROW(p.validate());
+  p.max_keyframes = 0;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = {};
   for (int bad : {0, 10001}) {
     p.max_iterations = bad;
     try {
@@ -126,8 +129,8 @@ TEST(BatchRefiner, RefinedTrajectoryBeatsTheOnlineWindowAndLandmarksConverge) {
   EXPECT_EQ(s.invalid_landmarks, 0);
   EXPECT_TRUE(s.covariance_computed);
   EXPECT_LT(s.final_cost, s.initial_cost);
-  std::cout << "whitened observation residuals: median " << s.observation_residual_median
-            << " p95 " << s.observation_residual_p95 << "\n";
+  std::cout << "whitened observation residuals: median " << s.observation_residual_median << " p95 "
+            << s.observation_residual_p95 << "\n";
   // The synthetic noise is what the covariances say: a k-dimensional whitened residual (k = 3-6)
   // has a norm of about sqrt(k) at the optimum.
   EXPECT_GT(s.observation_residual_median, 1.0);

@@ -125,6 +125,7 @@ TEST(PipelineParams, MappingYamlKeysAreAllRead) {
                    file["relocalisation_max_offset_difference"].as<double>());
   EXPECT_EQ(batch_refinement, file["batch_refinement"].as<bool>());
   EXPECT_EQ(batch.max_iterations, file["batch_max_iterations"].as<int>());
+  EXPECT_EQ(batch.max_keyframes, file["batch_max_keyframes"].as<int>());
   EXPECT_EQ(batch.compute_covariance, file["batch_compute_covariance"].as<bool>());
 }
 
@@ -133,21 +134,25 @@ TEST(PipelineParams, BatchRefinementKeysAreValidated) {
   bool enabled = false;
   qs::BatchRefiner::Params batch;
   qs::ParamLog log;
-  qs::readBatchRefinementParams(qs::YamlParamReader(YAML::Load("{window_size: 5}")), enabled,
-                                batch, log);
+  qs::readBatchRefinementParams(qs::YamlParamReader(YAML::Load("{window_size: 5}")), enabled, batch,
+                                log);
   EXPECT_FALSE(enabled);
   EXPECT_EQ(batch.max_iterations, qs::BatchRefiner::Params().max_iterations);
   qs::readBatchRefinementParams(
-      qs::YamlParamReader(YAML::Load("{batch_refinement: true, batch_max_iterations: 7}")),
-      enabled, batch, log);
+      qs::YamlParamReader(YAML::Load("{batch_refinement: true, batch_max_iterations: 7}")), enabled,
+      batch, log);
   EXPECT_TRUE(enabled);
   EXPECT_EQ(batch.max_iterations, 7);
-  for (const char* bad : {"{batch_max_iterations: 0}", "{batch_max_iterations: 10001}"}) {
+  for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
+           {"{batch_max_iterations: 0}", "max_iterations"},
+           {"{batch_max_iterations: 10001}", "max_iterations"},
+           {"{batch_max_keyframes: 0}", "max_keyframes"}}) {
+    qs::BatchRefiner::Params fresh;
     try {
-      qs::readBatchRefinementParams(qs::YamlParamReader(YAML::Load(bad)), enabled, batch, log);
+      qs::readBatchRefinementParams(qs::YamlParamReader(YAML::Load(bad)), enabled, fresh, log);
       ADD_FAILURE() << bad << " was accepted";
     } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find("max_iterations"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
     }
   }
 }

@@ -3,8 +3,8 @@
 // second, every mapped frame and keyframe is recorded, lost frames are not, the refined trajectory
 // holds exactly the mapped frames and is as accurate as the online one, and the landmarks held
 // fixed online while the map waited to be anchored again are refined (that mode is not a fixed
-// map). Off (the nodelets' default), nothing is recorded and refineBatch() refuses; a reset (time
-// going backwards) starts the recording again.
+// map). Off (the nodelets' default), nothing is recorded and refineBatch() refuses; past
+// batch_max_keyframes the recording stops; a reset (time going backwards) starts it again.
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -84,14 +84,23 @@ TEST(QuadricSlamBatch, OffRecordsNothingAndResetStartsAgain) {
   qs::QuadricSlam off(params);
   params.batch_refinement = true;
   qs::QuadricSlam on(params);
+  params.batch.max_keyframes = 1;
+  qs::QuadricSlam bounded(params);
   qs::SyntheticFrameSource source = deskSource(1.0);
   qs::RgbdFrame frame;
   std::size_t mapped = 0;
   while (source.next(frame)) {
     off.process(frame);
+    bounded.process(frame);
     mapped += on.process(frame).mapped;
   }
   ASSERT_GT(mapped, 0u);
+  // Past batch.max_keyframes the recording stops and is freed, and nothing is solved.
+  ASSERT_GE(on.batchRecorder().keyframes().size(), 2u);
+  EXPECT_TRUE(bounded.batchRecorder().frames().empty());
+  const qs::BatchSolution not_solved = bounded.refineBatch();
+  EXPECT_FALSE(not_solved.statistics.solution_usable);
+  EXPECT_NE(not_solved.statistics.report.find("batch_max_keyframes"), std::string::npos);
   EXPECT_TRUE(off.batchRecorder().frames().empty());
   EXPECT_TRUE(off.batchRecorder().keyframes().empty());
   EXPECT_THROW(off.refineBatch(), std::logic_error);
