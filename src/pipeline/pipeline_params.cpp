@@ -134,4 +134,13 @@ void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Par
   params.validate();
 }
 
+void readBatchRefinementParams(const ParamReader& reader, bool& enabled,
+                               BatchRefiner::Params& params, ParamLog& log) {
+  readParam(reader, "batch_refinement", enabled, log);
+  readParam(reader, "batch_max_iterations", params.max_iterations, log);
+  readParam(reader, "batch_max_keyframes", params.max_keyframes, log);
+  readParam(reader, "batch_compute_covariance", params.compute_covariance, log);
+  params.validate();
+}
+
 }  // namespace quadric_slam

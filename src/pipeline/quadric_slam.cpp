@@ -19,6 +19,7 @@ void SlamParams::validate() const {
   mapping.validate();
   reconstruction.validate();
   recovery.validate();
+  batch.validate();
   if (max_support_points < 0)
     throw std::invalid_argument("max_support_points must be >= 0, got " +
                                 std::to_string(max_support_points));
@@ -42,6 +43,7 @@ SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log) {
   const YamlParamReader mapping = reader("mapping.yaml");
   readMappingParams(mapping, params.mapping, params.reconstruction, effective);
   readTrackingRecoveryParams(mapping, params.recovery, effective);
+  readBatchRefinementParams(mapping, params.batch_refinement, params.batch, effective);
   params.validate();
   return params;
 }
@@ -60,6 +62,8 @@ void QuadricSlam::reset() {
   mapper_.reset();
   reconstruction_.clear();
   recovery_.reset();
+  batch_recorder_.clear();
+  batch_overflow_ = false;
   mapper_.setLocalizationOnly(false);
   T_map_odom_.setIdentity();
   has_stamp_ = false;
@@ -136,6 +140,14 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
   out.mapping =
       timer_.time("mapping", [&] { return mapper_.process(out.measurements, odometry_input); });
   out.mapped = out.mapping.status == FrameStatus::kOk;
+  if (params_.batch_refinement && !batch_overflow_) {
+    batch_recorder_.record(out.mapping, mapper_);
+    // Too large to solve: the recording stops and its memory is freed (refineBatch() says why).
+    batch_overflow_ =
+        static_cast<int>(batch_recorder_.keyframes().size()) > params_.batch.max_keyframes;
+    if (batch_overflow_)
+      batch_recorder_.clear();
+  }
   if (out.mapped) {
     recovery_.frameMapped(landmarkAssociations(out.mapping.update));
     T_map_odom_ = out.mapping.T_map_odom;
@@ -160,7 +172,22 @@ void QuadricSlam::addToReconstruction(const FrameMeasurements& measurements,
 std::vector<LandmarkMerge> QuadricSlam::mergeDuplicateLandmarks() {
   const std::vector<LandmarkMerge> merges = mapper_.mergeDuplicates();
   applyMergesToReconstruction(merges, &reconstruction_);
+  if (params_.batch_refinement && !batch_overflow_)
+    batch_recorder_.recordMerges(merges);
   return merges;
+}
+
+BatchSolution QuadricSlam::refineBatch() const {
+  if (!params_.batch_refinement)
+    throw std::logic_error("QuadricSlam::refineBatch: batch_refinement is off (nothing recorded)");
+  if (batch_overflow_) {
+    BatchSolution solution;
+    solution.statistics.report = "the run has more than batch_max_keyframes " +
+                                 std::to_string(params_.batch.max_keyframes) +
+                                 " keyframes: not recorded, not solved";
+    return solution;
+  }
+  return BatchRefiner(params_.batch).refine(batch_recorder_, mapper_);
 }
 
 pcl::PointCloud<pcl::PointXYZRGBL> QuadricSlam::reconstructionCloud() const {

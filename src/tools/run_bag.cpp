@@ -2,11 +2,17 @@
 // (pipeline/quadric_slam.h): every frame of a TUM rosbag or TUM folder through normals, quadric
 // segmentation, odometry and mapping, with the same config/*.yaml parameters as the nodelets, as
 // fast as the machine allows (no master, no real-time pacing). Writes
-//   DIR/trajectory.txt       the SLAM estimate, camera optical frame in the map frame (with
-//                            --odometry-only: the odometry, camera in the odom frame)
+//   DIR/trajectory.txt       the SLAM estimate, camera optical frame in the map frame: after the
+//                            offline batch refinement (mapping.yaml batch_refinement, on in the
+//                            package's config; mapping/batch_refiner.h) the refined trajectory,
+//                            else the online one (with --odometry-only: the odometry, camera in
+//                            the odom frame)
+//   DIR/trajectory_online.txt with the batch refinement: the online SLAM estimate (as the live
+//                            nodelet has it), for comparison
 //   DIR/trajectory_odom.txt  the odometry, camera optical frame in the odom frame
 //   DIR/timing.json          per-stage median/p95/max
-//   DIR/map.yaml             the landmarks (map schema), unless --odometry-only
+//   DIR/map.yaml             the landmarks (map schema), unless --odometry-only; refined by the
+//                            batch refinement when it ran (DIR/map_online.yaml: the online map)
 //   DIR/reconstruction.pcd   landmark points projected onto their surfaces (label = landmark id;
 //                            rgba = the pixel's colour when the input has RGB, alpha 255, else
 //                            the landmark's colour, alpha 0: ros/reconstruction_cloud.h)
@@ -15,12 +21,13 @@
 //                            the heap in use (eval/resource_usage.h: resident memory less what
 //                            the allocator holds free)
 // With --gt prints the ATE and RPE of the odometry (ate_rmse_m ...) and of SLAM (map_ate_rmse_m
-// ...). INPUT may also be a scene file (config/scenes/*.yaml): its frames are rendered as they are
+// ...); with the batch refinement also the online SLAM's (online_map_ate_rmse_m ...), and the
+// refinement's size and time (batch_seconds). INPUT may also be a scene file (config/scenes/*.yaml): its frames are rendered as they are
 // needed (sim/synthetic_frame_source.h), so a sequence of any length runs without a bag; the truth
 // goes to DIR/groundtruth.txt and is used when --gt is not given.
 //
 //   run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR] [--max-frames N]
-//           [--intrinsics fx,fy,cx,cy] [--quiet] [--sample-every N] [--no-rgb]
+//           [--intrinsics fx,fy,cx,cy] [--quiet] [--sample-every N] [--no-rgb] [--no-batch]
 //           [--seconds S] [--rate HZ] [--seed N]   (scene INPUT only)
 #include <pcl/io/pcd_io.h>
 #include <pcl_conversions/pcl_conversions.h>
@@ -59,6 +66,7 @@ struct Options {
   bool odometry_only = false;
   bool quiet = false;
   bool rgb = true;  // read RGB when the input has it (it colours the reconstruction only)
+  bool batch = true;  // false: no batch refinement whatever mapping.yaml says
   long max_frames = -1;
   long sample_every = 30;
   qs::CameraIntrinsics intrinsics;             // fx = 0: from the input
@@ -75,13 +83,16 @@ int usage(const std::string& problem) {
       << "run_bag: " << problem << "\n"
       << "usage: run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR]\n"
       << "               [--max-frames N] [--intrinsics fx,fy,cx,cy] [--quiet]\n"
-      << "               [--sample-every N] [--no-rgb] [--seconds S] [--rate HZ] [--seed N]\n"
+      << "               [--sample-every N] [--no-rgb] [--no-batch] [--seconds S] [--rate HZ]\n"
+      << "               [--seed N]\n"
       << "  INPUT: a TUM rosbag (.bag), a TUM folder (rgb.txt, depth.txt, depth/), or a scene\n"
       << "         file (config/scenes/*.yaml) rendered frame by frame: --seconds (default 60),\n"
       << "         --rate (default: the scene's), --seed (default 1) apply to it\n"
       << "  --sample-every N: a line of DIR/resources.csv every N frames (default 30)\n"
       << "  --no-rgb: depth only (by default RGB, when the input has it, colours the\n"
-      << "            reconstruction; frames without an RGB partner run uncoloured)\n";
+      << "            reconstruction; frames without an RGB partner run uncoloured)\n"
+      << "  --no-batch: no offline batch refinement (mapping.yaml batch_refinement): trajectory.txt\n"
+      << "              and map.yaml are the online estimates\n";
   return 2;
 }
 
@@ -106,6 +117,8 @@ bool parseOptions(int argc, char** argv, Options& o, std::string& problem) {
         o.odometry_only = true;
       } else if (arg == "--no-rgb") {
         o.rgb = false;
+      } else if (arg == "--no-batch") {
+        o.batch = false;
       } else if (arg == "--quiet") {
         o.quiet = true;
       } else if (arg == "--sample-every") {
@@ -189,6 +202,56 @@ void printTrajectoryErrors(const std::string& gt_path, const qs::Trajectory& est
   }
 }
 
+// The offline batch refinement (mapping/batch_refiner.h) of the run: writes the refined
+// trajectory to out_dir/trajectory.txt, prints its size, cost and time, and returns the refined
+// landmarks. After a reset of the input (time went backwards) only the last session was recorded:
+// then, or when the solve is not usable, trajectory.txt is the online one and the map stays online.
+std::vector<qs::QuadricLandmark> refineOffline(const qs::QuadricSlam& slam, std::size_t resets,
+                                               const std::string& out_dir) {
+  const std::string online = out_dir + "/trajectory_online.txt";
+  const std::string refined = out_dir + "/trajectory.txt";
+  if (resets > 0) {
+    std::printf("batch_refinement skipped: the input reset %zu times\n", resets);
+    fs::copy_file(online, refined, fs::copy_options::overwrite_existing);
+    return slam.mapper().landmarks();
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const qs::BatchSolution solution = slam.refineBatch();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const qs::BatchStatistics& s = solution.statistics;
+  std::printf(
+      "batch_refinement keyframes %d frames %d landmarks %d observations %d iterations %d cost "
+      "%.6g -> %.6g usable %d covariance %d invalid_landmarks %d skipped_observations %d\n",
+      s.keyframes, s.frames, s.landmarks, s.observation_factors, s.iterations, s.initial_cost,
+      s.final_cost, s.solution_usable, s.covariance_computed, s.invalid_landmarks,
+      s.skipped_observations);
+  std::printf("batch_seconds %.3f\nbatch_solve_seconds %.3f\nbatch_covariance_seconds %.3f\n",
+              seconds, s.solve_seconds, s.covariance_seconds);
+  std::printf("batch_report %s\n", s.report.c_str());
+  std::printf("batch observation residual (sigmas) median %.2f p95 %.2f\n",
+              s.observation_residual_median, s.observation_residual_p95);
+  if (!s.solution_usable) {
+    std::printf("batch_refinement not usable (%s): the online estimates are kept\n",
+                s.report.c_str());
+    fs::copy_file(online, refined, fs::copy_options::overwrite_existing);
+    return slam.mapper().landmarks();
+  }
+  qs::Trajectory trajectory;
+  for (const qs::RefinedPose& pose : solution.trajectory)
+    trajectory.push_back({pose.stamp, pose.T_map_camera});
+  qs::writeTumTrajectory(trajectory, refined,
+                         "quadric_slam run_bag: camera optical frame in the map frame, after the "
+                         "batch refinement");
+  // Refined surfaces may come to agree: counted, not merged (merging needs the online state).
+  std::map<int, qs::QuadricLandmark> refined_by_id;
+  for (const qs::QuadricLandmark& landmark : solution.landmarks)
+    refined_by_id[landmark.id] = landmark;
+  std::printf("batch duplicate pairs %zu\ntrajectory_online %s\n",
+              slam.mapper().map().merger().findDuplicates(refined_by_id).size(), online.c_str());
+  return solution.landmarks;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -200,6 +263,8 @@ int main(int argc, char** argv) {
   try {
     qs::SlamParams params = qs::loadSlamParams(o.config_dir);
     params.mapping_enabled = !o.odometry_only;
+    params.batch_refinement = params.batch_refinement && o.batch && !o.odometry_only;
+    const bool batch = params.batch_refinement;
     qs::QuadricSlam slam(params);
 
     std::unique_ptr<qs::FrameSource> source = openInput(o);
@@ -228,14 +293,15 @@ int main(int argc, char** argv) {
     qs::TumTrajectoryWriter odom_trajectory(
         o.out_dir + "/trajectory_odom.txt",
         "quadric_slam run_bag: camera optical frame in the odom frame");
+    // With the batch refinement trajectory.txt is written at the end, from the refined keyframes.
     qs::TumTrajectoryWriter slam_trajectory(
-        o.out_dir + "/trajectory.txt",
+        o.out_dir + (batch ? "/trajectory_online.txt" : "/trajectory.txt"),
         o.odometry_only ? "quadric_slam run_bag: camera optical frame in the odom frame"
                         : "quadric_slam run_bag: camera optical frame in the map frame");
     int status_counts[3] = {0, 0, 0};
     std::size_t frames_recovering = 0;  // the mapper localised only (after a loss of tracking)
     std::map<std::string, std::size_t> observations_per_class;
-    std::size_t frames = 0, skipped = 0, keyframes = 0, joined = 0, merged_online = 0;
+    std::size_t frames = 0, skipped = 0, keyframes = 0, joined = 0, merged_online = 0, resets = 0;
     // How each measurement fared against the landmarks (AssociationOutcome, mapping/association.h).
     std::map<qs::AssociationOutcome, std::size_t> outcomes;
     const auto start = std::chrono::steady_clock::now();
@@ -243,6 +309,7 @@ int main(int argc, char** argv) {
     while (frames < total && read_timer.time("read", [&] { return source->next(frame); })) {
       ++frames;
       const qs::SlamFrameResult result = slam.process(frame);
+      resets += result.reset;
       if (result.reset)
         std::cerr << "\nrun_bag: time went backwards at " << frame.stamp << ": reset\n";
       if (!result.processed) {
@@ -344,7 +411,12 @@ int main(int argc, char** argv) {
           "candidates joined at promotion %zu, landmarks merged online %zu, duplicate pairs "
           "left %zu, merged at save %zu, duplicate pairs saved %zu\n",
           joined, merged_online, duplicates_online, merged_at_save, duplicates_saved);
-      const std::vector<qs::QuadricLandmark> landmarks = slam.mapper().landmarks();
+      std::vector<qs::QuadricLandmark> landmarks = slam.mapper().landmarks();
+      if (batch) {
+        qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"),
+                         o.out_dir + "/map_online.yaml");
+        landmarks = refineOffline(slam, resets, o.out_dir);
+      }
       qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"), o.out_dir + "/map.yaml");
       std::map<std::string, int> per_class;
       for (const qs::QuadricLandmark& landmark : landmarks)
@@ -353,7 +425,12 @@ int main(int argc, char** argv) {
       std_msgs::Header header;
       header.frame_id = "map";
       pcl::PointCloud<pcl::PointXYZRGBL> points;
-      pcl::fromROSMsg(qs::reconstructionCloudMsg(slam.reconstructionCloud(), header), points);
+      // The points on their landmarks' final surfaces (refined ones after the batch refinement).
+      std::map<int, qs::QuadricModel> surfaces;
+      for (const qs::QuadricLandmark& landmark : landmarks)
+        surfaces[landmark.id] = landmark.quadric_map;
+      pcl::fromROSMsg(
+          qs::reconstructionCloudMsg(slam.reconstruction().cloud(surfaces), header), points);
       if (!points.empty())
         pcl::io::savePCDFileBinary(o.out_dir + "/reconstruction.pcd", points);
       std::printf("map landmarks %zu:", landmarks.size());
@@ -365,7 +442,11 @@ int main(int argc, char** argv) {
     if (!o.gt_path.empty()) {
       printTrajectoryErrors(o.gt_path, qs::readTumTrajectory(odom_trajectory.path()));
       if (!o.odometry_only)
-        printTrajectoryErrors(o.gt_path, qs::readTumTrajectory(slam_trajectory.path()), "map_");
+        printTrajectoryErrors(o.gt_path, qs::readTumTrajectory(o.out_dir + "/trajectory.txt"),
+                              "map_");
+      if (batch)
+        printTrajectoryErrors(o.gt_path, qs::readTumTrajectory(slam_trajectory.path()),
+                              "online_map_");
     }
   } catch (const std::exception& e) {
     std::cerr << "\nrun_bag: " << e.what() << "\n";

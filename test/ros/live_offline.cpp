@@ -5,7 +5,8 @@
 // synthetic desk bag must give the same map and the same trajectories. The offline side is the
 // offline runner run_bag (a thin shell over QuadricSlam), beside this checker; both maps are
 // taken after the last frame through the same writer (the nodelet's ~save_map, run_bag's
-// map.yaml). (The message QuadricMap and the core class of that name cannot meet in one
+// map.yaml; run_bag's offline batch refinement, which the live mapper does not have, is turned off
+// with --no-batch). (The message QuadricMap and the core class of that name cannot meet in one
 // translation unit: the pipeline runs in its own process.)
 //
 // The frames are published one at a time, each after the mapper's path has reached the previous
@@ -98,7 +99,7 @@ SlamRun runOffline(const std::string& bag_path, const fs::path& out_dir) {
   const fs::path run_bag = fs::canonical("/proc/self/exe").parent_path() / "run_bag";
   const std::string command = run_bag.string() + " " + bag_path + " --out " + out_dir.string() +
                               " --config " + QUADRIC_SLAM_SOURCE_DIR +
-                              "/config --quiet --no-rgb > " +
+                              "/config --quiet --no-rgb --no-batch > " +
                               (out_dir.parent_path() / "run_bag.log").string() + " 2>&1";
   SlamRun run;
   if (std::system(command.c_str()) != 0) {

@@ -144,6 +144,8 @@ class SlidingWindow {
   bool landmarkFixed(int landmark_id) const {
     return all_landmarks_fixed_ || fixed_landmarks_.count(landmark_id) > 0;
   }
+  // The landmarks marked one by one (setLandmarkFixed), without the all-fixed mode.
+  const std::set<int>& individuallyFixedLandmarks() const { return fixed_landmarks_; }
 
   // Landmark merged_id was merged into survivor_id (mapping/landmark_merger.h): its observations
   // in the window keyframes become the survivor's (the same measurements, now factors on the

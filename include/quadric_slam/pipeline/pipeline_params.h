@@ -7,6 +7,7 @@
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/io/param_reader.h"
+#include "quadric_slam/mapping/batch_refiner.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/mapping/tracking_recovery.h"
@@ -42,5 +43,11 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
 // relocalisation_max_angle_difference, relocalisation_max_offset_difference.
 void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Params& params,
                                 ParamLog& log);
+
+// config/mapping.yaml, the offline batch refinement at the end of run_bag (never read by the
+// nodelets): batch_refinement (on/off), batch_max_iterations, batch_max_keyframes,
+// batch_compute_covariance.
+void readBatchRefinementParams(const ParamReader& reader, bool& enabled,
+                               BatchRefiner::Params& params, ParamLog& log);
 
 }  // namespace quadric_slam

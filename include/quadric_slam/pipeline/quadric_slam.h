@@ -20,6 +20,9 @@
 //      the map where it was found (mapping/recovery_relocalisation.h).
 // Every stage is timed under its name (timer()): normals, segmentation, odometry, relocalisation
 // (only frames that tried), mapping, reconstruction.
+// With batch_refinement (offline only: run_bag) every mapped frame and keyframe is also recorded
+// (mapping/batch_recorder.h; memory grows with the run) so that refineBatch() can solve the whole
+// run at the end (mapping/batch_refiner.h).
 #pragma once
 
 #include <pcl/point_cloud.h>
@@ -35,6 +38,8 @@
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/io/param_reader.h"
+#include "quadric_slam/mapping/batch_recorder.h"
+#include "quadric_slam/mapping/batch_refiner.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/mapping/recovery_relocalisation.h"
@@ -57,15 +62,19 @@ struct SlamParams {
   int max_support_points = 1000;
   // false: normals and odometry only (no segmentation, no map).
   bool mapping_enabled = true;
+  // Record the run for the offline batch refinement (mapping.yaml batch_refinement; run_bag only,
+  // the nodelets never read it: the recording grows with the run) and its solver parameters.
+  bool batch_refinement = false;
+  BatchRefiner::Params batch;
 
   // Throws std::invalid_argument naming the bad field (of whichever stage) and its range.
   void validate() const;
 };
 
 // Reads config_dir/{normal_estimation,segmentation,odometry,mapping}.yaml through the key tables
-// the nodelets use; absent files keep the defaults of their stage. The effective values go to
-// *log when given. Throws std::runtime_error (unreadable file) or std::invalid_argument (bad
-// value).
+// the nodelets use (and mapping.yaml's batch_* keys, which only the offline runner uses); absent
+// files keep the defaults of their stage. The effective values go to *log when given. Throws
+// std::runtime_error (unreadable file) or std::invalid_argument (bad value).
 SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log = nullptr);
 
 struct SlamFrameResult {
@@ -96,6 +105,13 @@ class QuadricSlam {
   // Merges every pair of landmarks that are the same surface (QuadricMapper::mergeDuplicates) and
   // moves their reconstruction points to the survivors; call it before saving the map.
   std::vector<LandmarkMerge> mergeDuplicateLandmarks();
+  // With params().batch_refinement: one global solve over every keyframe and landmark since the
+  // last reset (mapping/batch_refiner.h), the mapped frames re-attached to their keyframes. Leaves
+  // the online state as it is. A run of more than batch.max_keyframes keyframes is neither
+  // recorded nor solved (the solution is then empty and not usable, its report says why).
+  // Throws std::logic_error when batch_refinement is off.
+  BatchSolution refineBatch() const;
+  const BatchRecorder& batchRecorder() const { return batch_recorder_; }
 
   const SlamParams& params() const { return params_; }
   const QuadricMapper& mapper() const { return mapper_; }
@@ -120,6 +136,8 @@ class QuadricSlam {
   QuadricMapper mapper_;
   QuadricReconstruction reconstruction_;
   TrackingRecovery recovery_;
+  BatchRecorder batch_recorder_;  // empty unless params_.batch_refinement
+  bool batch_overflow_ = false;   // more than batch.max_keyframes: recording stopped
   StageTimer timer_;
   bool has_stamp_ = false;
   double last_stamp_ = 0.0;

@@ -92,6 +92,10 @@ TEST(PipelineParams, MappingYamlKeysAreAllRead) {
   qs::ParamLog log;
   qs::readMappingParams(reader, mapper, reconstruction, log);
   qs::readTrackingRecoveryParams(reader, recovery, log);
+  // The offline runner's batch refinement (never read by the nodelet).
+  bool batch_refinement = false;
+  qs::BatchRefiner::Params batch;
+  qs::readBatchRefinementParams(reader, batch_refinement, batch, log);
   // Nodelet-level keys, read beside the tables.
   std::string text;
   bool flag = false;
@@ -119,4 +123,36 @@ TEST(PipelineParams, MappingYamlKeysAreAllRead) {
             file["relocalisation_min_supporting_surfaces"].as<int>());
   EXPECT_DOUBLE_EQ(recovery.relocaliser.matcher.max_offset_difference,
                    file["relocalisation_max_offset_difference"].as<double>());
+  EXPECT_EQ(batch_refinement, file["batch_refinement"].as<bool>());
+  EXPECT_EQ(batch.max_iterations, file["batch_max_iterations"].as<int>());
+  EXPECT_EQ(batch.max_keyframes, file["batch_max_keyframes"].as<int>());
+  EXPECT_EQ(batch.compute_covariance, file["batch_compute_covariance"].as<bool>());
+}
+
+// Off unless a file turns it on; a bad iteration count is refused naming the field.
+TEST(PipelineParams, BatchRefinementKeysAreValidated) {
+  bool enabled = false;
+  qs::BatchRefiner::Params batch;
+  qs::ParamLog log;
+  qs::readBatchRefinementParams(qs::YamlParamReader(YAML::Load("{window_size: 5}")), enabled, batch,
+                                log);
+  EXPECT_FALSE(enabled);
+  EXPECT_EQ(batch.max_iterations, qs::BatchRefiner::Params().max_iterations);
+  qs::readBatchRefinementParams(
+      qs::YamlParamReader(YAML::Load("{batch_refinement: true, batch_max_iterations: 7}")), enabled,
+      batch, log);
+  EXPECT_TRUE(enabled);
+  EXPECT_EQ(batch.max_iterations, 7);
+  for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
+           {"{batch_max_iterations: 0}", "max_iterations"},
+           {"{batch_max_iterations: 10001}", "max_iterations"},
+           {"{batch_max_keyframes: 0}", "max_keyframes"}}) {
+    qs::BatchRefiner::Params fresh;
+    try {
+      qs::readBatchRefinementParams(qs::YamlParamReader(YAML::Load(bad)), enabled, fresh, log);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  }
 }

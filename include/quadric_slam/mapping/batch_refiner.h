@@ -1,0 +1,104 @@
+// Offline batch refinement (the paper's batch solution of the factor graph, Fig. 3): after a run,
+// one Ceres problem over ALL recorded keyframes and ALL landmarks (mapping/batch_recorder.h), with
+// the factors and manifolds of the sliding window (mapping/window.h):
+//   - every keyframe pose T_map_camera (PoseManifold), an odometry factor between consecutive
+//     keyframes (RelativePoseCost, the recorded increment and its covariance),
+//   - every landmark observed from a keyframe (QuadricManifold of its class) with one
+//     QuadricObservationCost per observation (eqs. 20-22) under the window's Huber loss
+//     (observation_huber), landmarks held fixed one by one (a loaded, trusted map) constant
+//     (the localisation-only mode, also used while recovering from a loss of tracking, is not),
+//   - the gauge: the first keyframe held fixed (it defines the map frame).
+// No marginalisation prior and no landmark re-entry prior: every factor they summarised is in the
+// problem itself. Solved with the dog-leg trust region (ceres::DOGLEG, as the paper) for at most
+// max_iterations iterations, starting from the online estimates.
+// Then every mapped frame is re-attached to its keyframe through its odometry (the mapper's
+// prediction, with the refined keyframe pose):
+//   T_map_frame = T_map_keyframe_refined T_odom_keyframe^-1 T_odom_frame.
+// When the solve is not usable the online estimates are returned (solution_usable = false); a
+// landmark whose refined estimate is invalid (a scale pushed through zero) keeps its online one.
+// Cost: one sparse Schur solve over the whole run per iteration; memory and time grow with the
+// run's keyframes and observations: offline only.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "quadric_slam/mapping/batch_recorder.h"
+#include "quadric_slam/mapping/landmark.h"
+#include "quadric_slam/mapping/quadric_mapper.h"
+
+namespace quadric_slam {
+
+struct BatchStatistics {
+  int keyframes = 0;
+  int frames = 0;
+  int landmarks = 0;        // landmark blocks (observed from a keyframe)
+  int fixed_landmarks = 0;  // of which constant
+  int observation_factors = 0, odometry_factors = 0;
+  int skipped_observations =
+      0;                      // of landmarks no longer in the map (none when merges are recorded)
+  int invalid_landmarks = 0;  // refined estimate invalid: the online one kept
+  int iterations = 0;
+  double initial_cost = 0.0, final_cost = 0.0;
+  bool solution_usable = false;
+  bool covariance_computed = false;  // false: the landmarks keep their online covariances
+  std::string report;                // Ceres' one-line report
+  // Whitened observation residual norms at the solution (sigmas, before the robust loss): how
+  // well the measurement covariances describe the data (about sqrt(k) when they do).
+  double observation_residual_median = 0.0, observation_residual_p95 = 0.0;
+  double solve_seconds = 0.0, covariance_seconds = 0.0;  // wall time
+};
+
+struct RefinedPose {
+  double stamp = 0.0;  // s
+  Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
+};
+
+struct BatchSolution {
+  BatchStatistics statistics;
+  std::vector<Eigen::Isometry3d> keyframe_poses;  // per recorded keyframe, refined
+  std::vector<RefinedPose> trajectory;            // per recorded frame, re-attached
+  std::vector<QuadricLandmark> landmarks;         // the whole map (id order), refined estimates
+};
+
+class BatchRefiner {
+ public:
+  struct Params {
+    // Dog-leg iterations, int in [1, 10000].
+    int max_iterations = 100;
+    // A larger recording is not solved (refine() returns the online estimates, not usable) and
+    // QuadricSlam stops recording past it: the cost of an iteration grows up to cubically with the
+    // keyframes (surfaces seen from every keyframe, a floor, make the reduced camera system
+    // dense: 227 kitchen keyframes take 0.2 s an iteration), and the recording's memory with them.
+    // int in [1, 1000000].
+    int max_keyframes = 500;
+    // Marginal covariances of the refined landmarks (ceres::Covariance over the whole problem);
+    // false, or when they cannot be computed: the online covariances stay.
+    bool compute_covariance = true;
+
+    // Throws std::invalid_argument naming the bad field and its allowed range.
+    void validate() const;
+  };
+
+  BatchRefiner() : BatchRefiner(Params{}) {}
+  explicit BatchRefiner(const Params& params);
+
+  // The refined trajectory and map of a run recorded by `recorder` from `mapper` (its map gives
+  // the landmarks' online estimates, classes and which are fixed; its window the Huber loss).
+  BatchSolution refine(const BatchRecorder& recorder, const QuadricMapper& mapper) const;
+
+  const Params& params() const { return params_; }
+
+ private:
+  Params params_;
+};
+
+// T_map_frame = T_map_keyframe T_odom_keyframe^-1 T_odom_frame for every recorded frame, with
+// keyframe_poses[i] the pose of recorder.keyframes()[i] (frames before the first keyframe keep
+// their online estimate).
+std::vector<RefinedPose> reattachFrames(const BatchRecorder& recorder,
+                                        const std::vector<Eigen::Isometry3d>& keyframe_poses);
+
+}  // namespace quadric_slam

@@ -1,0 +1,237 @@
+#include "quadric_slam/mapping/batch_refiner.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <map>
+#include <memory>
+#include <stdexcept>
+
+#include "quadric_slam/geometry/manifolds.h"
+#include "quadric_slam/mapping/factors.h"
+
+namespace quadric_slam {
+
+namespace {
+
+using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using PoseBlock = std::array<double, kPoseParameterSize>;
+using QuadricBlock = std::array<double, kQuadricParameterSize>;
+
+double secondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Marginal covariances of the free landmarks, in their minimal tangent spaces; empty when Ceres
+// cannot compute them (a rank-deficient problem).
+std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
+                                                   const std::map<int, QuadricBlock>& blocks,
+                                                   const std::vector<int>& free_ids,
+                                                   const LandmarkRegistry& map) {
+  std::map<int, Eigen::MatrixXd> out;
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (int id : free_ids)
+    pairs.emplace_back(blocks.at(id).data(), blocks.at(id).data());
+  if (pairs.empty() || !covariance.Compute(pairs, problem))
+    return out;
+  for (int id : free_ids) {
+    const double* block = blocks.at(id).data();
+    const int k = minimalDimension(map.landmark(id).quadric_map.quadricClass());
+    RowMajor c(k, k);
+    if (!covariance.GetCovarianceBlockInTangentSpace(block, block, c.data()) || !c.allFinite())
+      continue;
+    const Eigen::MatrixXd symmetric = 0.5 * (c + c.transpose());
+    if (Eigen::LLT<Eigen::MatrixXd>(symmetric).info() == Eigen::Success)
+      out[id] = symmetric;
+  }
+  return out;
+}
+
+}  // namespace
+
+void BatchRefiner::Params::validate() const {
+  if (max_iterations < 1 || max_iterations > 10000)
+    throw std::invalid_argument("BatchRefiner::Params::max_iterations must be in [1, 10000]");
+  if (max_keyframes < 1 || max_keyframes > 1000000)
+    throw std::invalid_argument("BatchRefiner::Params::max_keyframes must be in [1, 1000000]");
+}
+
+BatchRefiner::BatchRefiner(const Params& params) : params_(params) {
+  params_.validate();
+}
+
+std::vector<RefinedPose> reattachFrames(const BatchRecorder& recorder,
+                                        const std::vector<Eigen::Isometry3d>& keyframe_poses) {
+  if (keyframe_poses.size() != recorder.keyframes().size())
+    throw std::invalid_argument("reattachFrames: one pose per recorded keyframe is needed");
+  std::vector<RefinedPose> out;
+  out.reserve(recorder.frames().size());
+  for (const RecordedFrame& frame : recorder.frames()) {
+    RefinedPose pose{frame.stamp, frame.T_map_camera};
+    if (frame.keyframe >= 0) {
+      const RecordedKeyframe& keyframe = recorder.keyframes()[frame.keyframe];
+      // The mapper's prediction (quadric_mapper.h, step 1) from the refined keyframe pose.
+      pose.T_map_camera =
+          keyframe_poses[frame.keyframe] * keyframe.T_odom_camera.inverse() * frame.T_odom_camera;
+    }
+    out.push_back(pose);
+  }
+  return out;
+}
+
+BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
+                                   const QuadricMapper& mapper) const {
+  const auto start = std::chrono::steady_clock::now();
+  const LandmarkRegistry& map = mapper.map();
+  const SlidingWindow& window = mapper.window();
+  const std::vector<RecordedKeyframe>& keyframes = recorder.keyframes();
+  BatchSolution solution;
+  BatchStatistics& stats = solution.statistics;
+  stats.keyframes = static_cast<int>(keyframes.size());
+  stats.frames = static_cast<int>(recorder.frames().size());
+  for (const RecordedKeyframe& keyframe : keyframes)
+    solution.keyframe_poses.push_back(keyframe.T_map_camera);
+  for (const auto& [id, landmark] : map.landmarks())
+    solution.landmarks.push_back(landmark);
+  if (keyframes.empty() || stats.keyframes > params_.max_keyframes) {
+    if (!keyframes.empty())
+      stats.report = std::to_string(stats.keyframes) + " keyframes, more than max_keyframes " +
+                     std::to_string(params_.max_keyframes) + ": not solved";
+    solution.trajectory = reattachFrames(recorder, solution.keyframe_poses);
+    return solution;
+  }
+
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  PoseManifold pose_manifold;
+  std::map<QuadricClass, std::unique_ptr<QuadricManifold>> quadric_manifolds;
+  std::unique_ptr<ceres::LossFunction> huber;
+  // Landmarks held fixed one by one (a trusted, loaded map) stay constant; the window's
+  // localisation-only mode (also set while recovering from a loss of tracking) is a mode of the
+  // online estimation, not a property of the landmarks: the batch refines them.
+  auto fixed = [&](int id) { return window.individuallyFixedLandmarks().count(id) > 0; };
+  if (window.params().observation_huber > 0.0)
+    huber = std::make_unique<ceres::HuberLoss>(window.params().observation_huber);
+
+  // Poses, the gauge and the odometry chain.
+  std::vector<PoseBlock> poses(keyframes.size());
+  for (std::size_t i = 0; i < keyframes.size(); ++i) {
+    poseToParameters(keyframes[i].T_map_camera, poses[i].data());
+    problem.AddParameterBlock(poses[i].data(), kPoseParameterSize, &pose_manifold);
+  }
+  problem.SetParameterBlockConstant(poses[0].data());
+  for (std::size_t i = 1; i < keyframes.size(); ++i) {
+    problem.AddResidualBlock(
+        RelativePoseCost::Create(keyframes[i].T_previous_this, keyframes[i].increment_covariance),
+        nullptr, poses[i - 1].data(), poses[i].data());
+    ++stats.odometry_factors;
+  }
+
+  // Landmarks and every keyframe observation of them.
+  std::map<int, QuadricBlock> landmarks;
+  std::vector<ceres::ResidualBlockId> observation_blocks;
+  for (std::size_t i = 0; i < keyframes.size(); ++i) {
+    for (const WindowObservation& observation : keyframes[i].observations) {
+      const int id = observation.landmark_id;
+      if (map.landmarks().count(id) == 0) {
+        ++stats.skipped_observations;
+        continue;
+      }
+      auto it = landmarks.find(id);
+      if (it == landmarks.end()) {
+        const QuadricModel& quadric = map.landmark(id).quadric_map;
+        it = landmarks.emplace(id, QuadricBlock{}).first;
+        quadricToParameters(quadric, it->second.data());
+        auto& manifold = quadric_manifolds[quadric.quadricClass()];
+        if (!manifold)
+          manifold = std::make_unique<QuadricManifold>(quadric.quadricClass());
+        problem.AddParameterBlock(it->second.data(), kQuadricParameterSize, manifold.get());
+        if (fixed(id)) {
+          problem.SetParameterBlockConstant(it->second.data());
+          ++stats.fixed_landmarks;
+        }
+      }
+      observation_blocks.push_back(problem.AddResidualBlock(
+          QuadricObservationCost::Create(observation.measurement.quadric_camera,
+                                         observation.measurement.covariance),
+          huber.get(), poses[i].data(), it->second.data()));
+      ++stats.observation_factors;
+    }
+  }
+  stats.landmarks = static_cast<int>(landmarks.size());
+
+  ceres::Solver::Options options;
+  options.minimizer_type = ceres::TRUST_REGION;
+  options.trust_region_strategy_type = ceres::DOGLEG;
+  options.dogleg_type = ceres::TRADITIONAL_DOGLEG;
+  options.linear_solver_type = ceres::SPARSE_SCHUR;
+  options.max_num_iterations = params_.max_iterations;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  stats.iterations = static_cast<int>(summary.iterations.size());
+  stats.initial_cost = summary.initial_cost;
+  stats.final_cost = summary.final_cost;
+  stats.solution_usable = summary.IsSolutionUsable();
+  stats.report = summary.BriefReport();
+  stats.solve_seconds = secondsSince(start);
+  if (!stats.solution_usable) {
+    solution.trajectory = reattachFrames(recorder, solution.keyframe_poses);
+    return solution;
+  }
+
+  for (std::size_t i = 0; i < keyframes.size(); ++i)
+    solution.keyframe_poses[i] = poseFromParameters(poses[i].data());
+  std::vector<double> norms;
+  for (ceres::ResidualBlockId id : observation_blocks) {
+    Eigen::VectorXd r(problem.GetCostFunctionForResidualBlock(id)->num_residuals());
+    double cost = 0.0;
+    if (problem.EvaluateResidualBlock(id, false, &cost, r.data(), nullptr))
+      norms.push_back(r.norm());
+  }
+  if (!norms.empty()) {
+    std::sort(norms.begin(), norms.end());
+    stats.observation_residual_median = norms[norms.size() / 2];
+    stats.observation_residual_p95 = norms[std::min(norms.size() - 1, norms.size() * 95 / 100)];
+  }
+  std::vector<int> free_ids;
+  for (const auto& [id, block] : landmarks)
+    if (!fixed(id))
+      free_ids.push_back(id);
+  const auto covariance_start = std::chrono::steady_clock::now();
+  std::map<int, Eigen::MatrixXd> covariances;
+  if (params_.compute_covariance)
+    covariances = landmarkCovariances(&problem, landmarks, free_ids, map);
+  stats.covariance_computed = !covariances.empty();
+  stats.covariance_seconds = secondsSince(covariance_start);
+  for (QuadricLandmark& landmark : solution.landmarks) {
+    if (landmarks.count(landmark.id) == 0 || fixed(landmark.id))
+      continue;
+    const QuadricModel& online = landmark.quadric_map;
+    try {
+      landmark.quadric_map = quadricFromParameters(landmarks.at(landmark.id).data(),
+                                                   online.quadricClass(), online.signature());
+    } catch (const std::invalid_argument&) {
+      ++stats.invalid_landmarks;  // the online estimate stays
+      continue;
+    }
+    const auto c = covariances.find(landmark.id);
+    if (c != covariances.end())
+      landmark.covariance = c->second;
+  }
+  solution.trajectory = reattachFrames(recorder, solution.keyframe_poses);
+  return solution;
+}
+
+}  // namespace quadric_slam
