@@ -199,12 +199,36 @@ unset multiplot
     return "\n".join(lines)
 
 
+def evaluation_section(out):
+    """Each run's map and trajectory against the scene's truth (DIR/<part>/evaluation.txt, written
+    by scripts/evaluate): ATE, the map summary, the per-class lines."""
+    lines = ["## Maps against the scene's truth", ""]
+    found = False
+    for part in ("offline", "live"):
+        path = os.path.join(out, part, "evaluation.txt")
+        if not os.path.exists(path):
+            continue
+        found = True
+        lines.append(f"{part} ({path}):")
+        lines.append("")
+        with open(path) as f:
+            for line in f:
+                if line.startswith(("ate_rmse_m", "pairs", "map_summary", "class ")):
+                    lines.append("    " + line.rstrip())
+        lines.append("")
+    if not found:
+        lines.append("(no evaluation: a run without its map, trajectory or ground truth)")
+        lines.append("")
+    return "\n".join(lines)
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--out", required=True)
     parser.add_argument("--header", default="# Long runs")
     args = parser.parse_args()
-    report = "\n".join([args.header, "", offline_section(args.out), live_section(args.out)])
+    report = "\n".join([args.header, "", offline_section(args.out), live_section(args.out),
+                        evaluation_section(args.out)])
     with open(os.path.join(args.out, "report.md"), "w") as f:
         f.write(report)
 

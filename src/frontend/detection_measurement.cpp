@@ -1,8 +1,9 @@
 #include "quadric_slam/frontend/detection_measurement.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
-#include <unordered_map>
 #include <vector>
 
 namespace quadric_slam {
@@ -45,38 +46,41 @@ void attachSupportPoints(FrameMeasurements& frame, const Segmentation& segmentat
   if (max_points <= 0 || frame.observations.empty() || labels.empty() ||
       labels.cols != static_cast<int>(cloud.width) || labels.rows != static_cast<int>(cloud.height))
     return;
-  // label -> observation; counts per label decide the stride.
-  std::unordered_map<int, std::size_t> observation_of_label;
-  for (std::size_t i = 0; i < frame.observations.size(); ++i)
-    if (frame.observations[i].label > 0)
-      observation_of_label[frame.observations[i].label] = i;
+  // label -> observation + 1 (0: none), a table over the 16-bit labels (a lookup per labelled
+  // pixel, twice per frame); counts per label decide the stride.
+  std::vector<std::size_t> observation_of_label(std::numeric_limits<std::uint16_t>::max() + 1, 0);
+  for (std::size_t i = 0; i < frame.observations.size(); ++i) {
+    const int label = frame.observations[i].label;
+    if (label > 0 && label <= std::numeric_limits<std::uint16_t>::max())
+      observation_of_label[label] = i + 1;
+  }
   std::vector<int> count(frame.observations.size(), 0), seen(frame.observations.size(), 0);
-  for (int v = 0; v < labels.rows; ++v)
-    for (int u = 0; u < labels.cols; ++u) {
-      const int label = labels.at<std::uint16_t>(v, u);
-      const auto it = label > 0 ? observation_of_label.find(label) : observation_of_label.end();
-      if (it != observation_of_label.end())
-        ++count[it->second];
-    }
+  for (int v = 0; v < labels.rows; ++v) {
+    const std::uint16_t* row = labels.ptr<std::uint16_t>(v);
+    for (int u = 0; u < labels.cols; ++u)
+      if (const std::size_t o = observation_of_label[row[u]]; o != 0)
+        ++count[o - 1];
+  }
   std::vector<int> stride(frame.observations.size(), 1);
   for (std::size_t i = 0; i < frame.observations.size(); ++i) {
     stride[i] = std::max(1, (count[i] + max_points - 1) / max_points);
     frame.observations[i].support_points.clear();
     frame.observations[i].support_points.reserve(std::min(count[i], max_points));
   }
-  for (int v = 0; v < labels.rows; ++v)
+  for (int v = 0; v < labels.rows; ++v) {
+    const std::uint16_t* row = labels.ptr<std::uint16_t>(v);
     for (int u = 0; u < labels.cols; ++u) {
-      const int label = labels.at<std::uint16_t>(v, u);
-      const auto it = label > 0 ? observation_of_label.find(label) : observation_of_label.end();
-      if (it == observation_of_label.end())
+      const std::size_t o = observation_of_label[row[u]];
+      if (o == 0)
         continue;
-      const std::size_t i = it->second;
+      const std::size_t i = o - 1;
       QuadricMeasurement& m = frame.observations[i];
       const Eigen::Vector3f p = cloud(u, v).getVector3fMap();
       if (seen[i]++ % stride[i] == 0 && p.allFinite() &&
           static_cast<int>(m.support_points.size()) < max_points)
         m.support_points.push_back(p);
     }
+  }
 }
 
 }  // namespace quadric_slam

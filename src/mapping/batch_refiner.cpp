@@ -12,46 +12,17 @@
 
 #include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/mapping/factors.h"
+#include "quadric_slam/mapping/solver_setup.h"
 
 namespace quadric_slam {
 
 namespace {
 
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using PoseBlock = std::array<double, kPoseParameterSize>;
 using QuadricBlock = std::array<double, kQuadricParameterSize>;
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-// Marginal covariances of the free landmarks, in their minimal tangent spaces; empty when Ceres
-// cannot compute them (a rank-deficient problem).
-std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
-                                                   const std::map<int, QuadricBlock>& blocks,
-                                                   const std::vector<int>& free_ids,
-                                                   const LandmarkRegistry& map) {
-  std::map<int, Eigen::MatrixXd> out;
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::SPARSE_QR;
-  options.num_threads = 1;
-  ceres::Covariance covariance(options);
-  std::vector<std::pair<const double*, const double*>> pairs;
-  for (int id : free_ids)
-    pairs.emplace_back(blocks.at(id).data(), blocks.at(id).data());
-  if (pairs.empty() || !covariance.Compute(pairs, problem))
-    return out;
-  for (int id : free_ids) {
-    const double* block = blocks.at(id).data();
-    const int k = minimalDimension(map.landmark(id).quadric_map.quadricClass());
-    RowMajor c(k, k);
-    if (!covariance.GetCovarianceBlockInTangentSpace(block, block, c.data()) || !c.allFinite())
-      continue;
-    const Eigen::MatrixXd symmetric = 0.5 * (c + c.transpose());
-    if (Eigen::LLT<Eigen::MatrixXd>(symmetric).info() == Eigen::Success)
-      out[id] = symmetric;
-  }
-  return out;
 }
 
 }  // namespace
@@ -169,15 +140,11 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
   }
   stats.landmarks = static_cast<int>(landmarks.size());
 
-  ceres::Solver::Options options;
+  // The paper's batch solver: dog-leg.
+  ceres::Solver::Options options = landmarkSolverOptions(params_.max_iterations);
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::DOGLEG;
   options.dogleg_type = ceres::TRADITIONAL_DOGLEG;
-  options.linear_solver_type = ceres::SPARSE_SCHUR;
-  options.max_num_iterations = params_.max_iterations;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
-  options.minimizer_progress_to_stdout = false;
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   stats.iterations = static_cast<int>(summary.iterations.size());
@@ -205,14 +172,15 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
     stats.observation_residual_median = norms[norms.size() / 2];
     stats.observation_residual_p95 = norms[std::min(norms.size() - 1, norms.size() * 95 / 100)];
   }
-  std::vector<int> free_ids;
+  std::map<int, LandmarkBlock> free_blocks;
   for (const auto& [id, block] : landmarks)
     if (!fixed(id))
-      free_ids.push_back(id);
+      free_blocks[id] = {block.data(),
+                         minimalDimension(map.landmark(id).quadric_map.quadricClass())};
   const auto covariance_start = std::chrono::steady_clock::now();
   std::map<int, Eigen::MatrixXd> covariances;
   if (params_.compute_covariance)
-    covariances = landmarkCovariances(&problem, landmarks, free_ids, map);
+    covariances = landmarkCovariances(&problem, free_blocks);
   stats.covariance_computed = !covariances.empty();
   stats.covariance_seconds = secondsSince(covariance_start);
   for (QuadricLandmark& landmark : solution.landmarks) {

@@ -1,6 +1,8 @@
 #include "quadric_slam/mapping/reconstruction.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -29,16 +31,70 @@ QuadricReconstruction::QuadricReconstruction(const Params& params) : params_(par
   params_.validate();
 }
 
-std::uint64_t QuadricReconstruction::voxelKey(const Eigen::Vector3d& p_quadric) const {
-  // 21 bits per axis (two's complement, wrapped): unique within +-10 km at 1 cm voxels. Voxels
-  // are centred on the quadric frame's axes, so a plane (z = 0 in its frame) lies in the middle
-  // of one layer of voxels rather than on the boundary between two.
-  const auto axis = [&](double value) {
-    return static_cast<std::uint64_t>(
-               static_cast<std::int64_t>(std::floor(value / params_.voxel_size + 0.5))) &
-           ((std::uint64_t{1} << 21) - 1);
-  };
-  return axis(p_quadric.x()) | axis(p_quadric.y()) << 21 | axis(p_quadric.z()) << 42;
+namespace {
+
+// 21 bits per index (two's complement, wrapped): unique within +-10 km at 1 cm cells.
+std::uint64_t packCell(std::int64_t a, std::int64_t b, std::int64_t c) {
+  constexpr std::uint64_t kMask = (std::uint64_t{1} << 21) - 1;
+  return (static_cast<std::uint64_t>(a) & kMask) | (static_cast<std::uint64_t>(b) & kMask) << 21 |
+         (static_cast<std::uint64_t>(c) & kMask) << 42;
+}
+
+// Cells are centred on zero (a plane's cells on its frame's origin, azimuth 0 in a cell's middle).
+std::int64_t cellIndex(double value, double step) {
+  return static_cast<std::int64_t>(std::floor(value / step + 0.5));
+}
+
+// The radius (sphere, cylinder) or half angle (cone) of a landmark estimate; 0 for the others.
+double shapeSize(const QuadricModel& quadric) {
+  switch (quadric.quadricClass()) {
+    case QuadricClass::kSphere:
+    case QuadricClass::kCylinder:
+      return 1.0 / quadric.scale().x();
+    case QuadricClass::kCone:
+      return std::atan2(1.0, quadric.scale().x());
+    default:
+      return 0.0;
+  }
+}
+
+}  // namespace
+
+std::uint64_t QuadricReconstruction::cellKey(const LandmarkPoints& stored,
+                                             const Eigen::Vector3d& p) const {
+  const double v = params_.voxel_size;
+  // The third index tells the 2D keys of the surface classes from each other's layouts; it is 0
+  // for them (a landmark never changes class).
+  switch (stored.quadric_class) {
+    case QuadricClass::kPlane:  // the normal is the frame's x axis
+      return packCell(cellIndex(p.y(), v), cellIndex(p.z(), v), 0);
+    case QuadricClass::kCylinder: {  // axis = z
+      const double azimuth_step = v / std::max(stored.reference_size, v);
+      return packCell(cellIndex(std::atan2(p.y(), p.x()), azimuth_step), cellIndex(p.z(), v), 0);
+    }
+    case QuadricClass::kCone: {  // apex at the origin, axis = z: the circle at height z has
+      // radius z tan(half angle), so the azimuth step follows the height's cell
+      const std::int64_t height = cellIndex(p.z(), v);
+      const double radius = std::abs(static_cast<double>(height)) * v *
+                            std::tan(std::min(stored.reference_size, 1.5));
+      return packCell(cellIndex(std::atan2(p.y(), p.x()), v / std::max(radius, v)), height, 0);
+    }
+    case QuadricClass::kSphere: {  // centre at the origin
+      const double r = p.norm();
+      if (r > 0.0) {
+        const double step = v / std::max(stored.reference_size, v);
+        const std::int64_t elevation = cellIndex(std::asin(std::clamp(p.z() / r, -1.0, 1.0)), step);
+        // Circles of latitude shrink towards the poles: the azimuth step grows with them.
+        const double circle =
+            std::max(stored.reference_size, v) * std::cos(static_cast<double>(elevation) * step);
+        return packCell(cellIndex(std::atan2(p.y(), p.x()), v / std::max(circle, v)), elevation, 0);
+      }
+      break;
+    }
+    default:
+      break;
+  }
+  return packCell(cellIndex(p.x(), v), cellIndex(p.y(), v), cellIndex(p.z(), v));
 }
 
 int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
@@ -50,6 +106,10 @@ int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
         "QuadricReconstruction::addPoints: " + std::to_string(colours_rgba.size()) +
         " colours for " + std::to_string(points_camera.size()) + " points");
   LandmarkPoints& stored = landmarks_[id];
+  if (stored.points_quadric.empty()) {
+    stored.quadric_class = landmark_map.quadricClass();
+    stored.reference_size = shapeSize(landmark_map);
+  }
   const Eigen::Isometry3d T_quadric_map = landmark_map.pose().inverse();
   const bool exact = landmark_map.quadricClass() != QuadricClass::kGeneral;
   int added = 0;
@@ -61,20 +121,23 @@ int QuadricReconstruction::addPoints(int id, const QuadricModel& landmark_map,
     if (!point.allFinite())
       continue;
     const Eigen::Vector3d p_map = T_map_camera * point.cast<double>();
-    const double distance =
-        exact ? exactDistance(landmark_map, p_map) : firstOrderDistance(landmark_map, p_map);
-    if (!(distance <= params_.max_surface_distance))
-      continue;
     // Stored on the surface: the sensor's noise along the normal would otherwise spread one
     // patch of surface over a stack of voxels, and every pass over it would add points (the map
-    // grows over time without seeing anything new).
-    Eigen::Vector3d p_quadric;
+    // grows over time without seeing anything new). For the exact classes the projection is the
+    // closest surface point, so it gives the distance too; a general quadric is tested with the
+    // first-order distance before its (iterative) projection.
+    if (!exact && !(firstOrderDistance(landmark_map, p_map) <= params_.max_surface_distance))
+      continue;
+    Eigen::Vector3d p_surface;
     try {
-      p_quadric = T_quadric_map * projector_.project(landmark_map, p_map);
+      p_surface = projector_.project(landmark_map, p_map);
     } catch (const std::invalid_argument&) {
       continue;  // a general quadric whose projection does not converge from here
     }
-    if (!stored.voxels.insert(voxelKey(p_quadric)).second)
+    if (exact && !((p_map - p_surface).norm() <= params_.max_surface_distance))
+      continue;
+    const Eigen::Vector3d p_quadric = T_quadric_map * p_surface;
+    if (!stored.voxels.insert(cellKey(stored, p_quadric)).second)
       continue;
     if (!colours_rgba.empty() && (colours_rgba[i] >> 24) != 0) {
       stored.rgba.resize(stored.points_quadric.size(), 0u);  // earlier points stay uncoloured
@@ -95,12 +158,16 @@ void QuadricReconstruction::moveLandmark(int from, int to, const Eigen::Isometry
     return;
   LandmarkPoints& target = landmarks_[to];
   const LandmarkPoints& moved = source->second;
+  if (target.points_quadric.empty()) {  // the same surface: its cells as the moved landmark's
+    target.quadric_class = moved.quadric_class;
+    target.reference_size = moved.reference_size;
+  }
   total_points_ -= moved.points_quadric.size() + target.points_quadric.size();
   for (std::size_t i = 0; i < moved.points_quadric.size(); ++i) {
     if (static_cast<int>(target.points_quadric.size()) >= params_.max_points_per_landmark)
       break;
     const Eigen::Vector3d p_to = T_to_from * moved.points_quadric[i].cast<double>();
-    if (!target.voxels.insert(voxelKey(p_to)).second)
+    if (!target.voxels.insert(cellKey(target, p_to)).second)
       continue;
     // The colour travels with its point (rgba may be shorter than the points: the tail is
     // uncoloured).

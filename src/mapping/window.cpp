@@ -13,6 +13,7 @@
 #include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/mapping/factors.h"
 #include "quadric_slam/mapping/observation_linearization.h"
+#include "quadric_slam/mapping/solver_setup.h"
 #include "quadric_slam/mapping/surface_fusion.h"
 
 namespace quadric_slam {
@@ -136,11 +137,11 @@ struct SlidingWindow::Problem {
   std::map<QuadricClass, std::unique_ptr<QuadricManifold>> quadric_manifolds;
   std::unique_ptr<ceres::LossFunction> huber;
   ceres::Problem problem;
-  std::list<PoseBlock> poses;                 // front = oldest keyframe (stable addresses)
-  std::map<int, QuadricBlock> landmarks;      // landmark id -> block
+  std::list<PoseBlock> poses;                        // front = oldest keyframe (stable addresses)
+  std::map<int, QuadricBlock> landmarks;             // landmark id -> block
   std::map<const double*, PriorVariable> variables;  // every pose and landmark block
   ceres::ResidualBlockId marginal_prior = nullptr;
-  PoseBlock identity{};                       // the constant pose of landmark priors
+  PoseBlock identity{};  // the constant pose of landmark priors
 
   QuadricManifold* manifold(QuadricClass c) {
     auto& m = quadric_manifolds[c];
@@ -288,12 +289,7 @@ WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
   last_.residual_blocks = problem.NumResidualBlocks();
   last_.residuals = problem.NumResiduals();
 
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::SPARSE_SCHUR;
-  options.max_num_iterations = params_.max_iterations;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
-  options.minimizer_progress_to_stdout = false;
+  const ceres::Solver::Options options = landmarkSolverOptions(params_.max_iterations);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   last_.iterations = static_cast<int>(summary.iterations.size());
@@ -334,33 +330,19 @@ void SlidingWindow::writeBack(Problem* P, const std::vector<double*>& poses,
   for (const auto& [id, block] : P->landmarks)
     if (!landmarkFixed(id))
       free_landmarks.push_back(id);
+  std::map<int, LandmarkBlock> free_blocks;
+  for (int id : free_landmarks)
+    free_blocks[id] = {P->landmarks.at(id).data(),
+                       minimalDimension(map->landmark(id).quadric_map.quadricClass())};
   std::map<int, Eigen::MatrixXd> covariances;
-  if (params_.compute_covariance && !free_landmarks.empty()) {
-    ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::SPARSE_QR;
-    covariance_options.num_threads = 1;
-    ceres::Covariance covariance(covariance_options);
-    std::vector<std::pair<const double*, const double*>> blocks;
-    for (int id : free_landmarks)
-      blocks.emplace_back(P->landmarks.at(id).data(), P->landmarks.at(id).data());
-    if (covariance.Compute(blocks, &problem)) {
-      for (int id : free_landmarks) {
-        const double* block = P->landmarks.at(id).data();
-        const int k = minimalDimension(map->landmark(id).quadric_map.quadricClass());
-        RowMajor c(k, k);
-        if (!covariance.GetCovarianceBlockInTangentSpace(block, block, c.data()) || !c.allFinite())
-          continue;
-        const Eigen::MatrixXd symmetric = 0.5 * (c + c.transpose());
-        if (Eigen::LLT<Eigen::MatrixXd>(symmetric).info() == Eigen::Success)
-          covariances[id] = symmetric;
-      }
-    }
-  }
+  if (params_.compute_covariance)
+    covariances = landmarkCovariances(&problem, free_blocks);
   for (int id : free_landmarks) {
     const QuadricModel& old = map->landmark(id).quadric_map;
     double* block = P->landmarks.at(id).data();
     try {
-      const QuadricModel updated = quadricFromParameters(block, old.quadricClass(), old.signature());
+      const QuadricModel updated =
+          quadricFromParameters(block, old.quadricClass(), old.signature());
       auto it = covariances.find(id);
       map->setEstimate(id, updated, it != covariances.end() ? it->second : Eigen::MatrixXd());
     } catch (const std::invalid_argument&) {
@@ -464,8 +446,8 @@ void SlidingWindow::marginalizeOldest(Problem* P, const LandmarkRegistry& map) {
     std::copy(block, block + v.ambientSize(), v.x0.begin());
     variables.push_back(v);
   }
-  marginal_prior_ = schurComplementPrior(variables, eliminate, A.transpose() * A,
-                                         A.transpose() * r);
+  marginal_prior_ =
+      schurComplementPrior(variables, eliminate, A.transpose() * A, A.transpose() * r);
 
   // A landmark leaving the window keeps its estimate in the map; seen again, it re-enters with a
   // prior from its covariance there.
@@ -478,8 +460,8 @@ void SlidingWindow::marginalizeOldest(Problem* P, const LandmarkRegistry& map) {
     const Eigen::LLT<Eigen::MatrixXd> llt(landmark.covariance);
     if (llt.info() != Eigen::Success)
       continue;
-    const Eigen::MatrixXd information =
-        llt.solve(Eigen::MatrixXd::Identity(landmark.covariance.rows(), landmark.covariance.cols()));
+    const Eigen::MatrixXd information = llt.solve(
+        Eigen::MatrixXd::Identity(landmark.covariance.rows(), landmark.covariance.cols()));
     priors_[id] = {landmark.quadric_map, 0.5 * (information + information.transpose())};
   }
 

@@ -1,7 +1,10 @@
 #include "quadric_slam/pipeline/quadric_slam.h"
 
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "quadric_slam/frontend/detection_measurement.h"
@@ -69,50 +72,108 @@ void QuadricSlam::reset() {
   has_stamp_ = false;
 }
 
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+// fn() timed under `stage` in the timer and into *ms; returns what fn() returns.
+template <typename Fn>
+auto timeStage(StageTimer& timer, const std::string& stage, double* ms, Fn&& fn) {
+  const auto start = Clock::now();
+  auto result = fn();
+  *ms = msSince(start);
+  timer.add(stage, *ms);
+  return result;
+}
+
+}  // namespace
+
 SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
-  SlamFrameResult out;
-  out.stamp = frame.stamp;
+  FrontEndFrame front;
+  std::swap(front.cloud, spare_cloud_);  // the storage of the frame before last
+  frontEnd(frame, &front);
+  SlamFrameResult out = backEnd(&front);
+  std::swap(front.cloud, spare_cloud_);
+  return out;
+}
+
+void QuadricSlam::frontEnd(const RgbdFrame& frame, FrontEndFrame* out) const {
+  out->stamp = frame.stamp;
+  out->frame_id = frame.frame_id;
+  out->intrinsics = frame.intrinsics;
+  out->problem.clear();
+  out->colour_problem.clear();
+  out->segmentation = Segmentation();
+  out->measurements = FrameMeasurements();
+  out->normals_ms = out->segmentation_ms = 0.0;
+  const CameraIntrinsics& k = frame.intrinsics;
   if (!std::isfinite(frame.stamp)) {
-    out.message = "stamp is not finite";
+    out->problem = "stamp is not finite";
+    return;
+  }
+  out->problem = imageSizeProblem(k, frame.depth_m.cols, frame.depth_m.rows);
+  if (!out->problem.empty())
+    return;
+  if (frame.depth_m.type() != CV_32FC1) {
+    out->problem = "depth image must be CV_32FC1 metres";
+    return;
+  }
+  auto start = Clock::now();
+  normals_.compute(backProject(depthViewOf(frame.depth_m), k, params_.back_projection), out->cloud);
+  out->normals_ms = msSince(start);
+  if (!params_.mapping_enabled)
+    return;
+  start = Clock::now();
+  out->segmentation = segmenter_.segment(out->cloud);
+  out->segmentation_ms = msSince(start);
+  out->measurements = toFrameMeasurements(out->segmentation, frame.stamp, frame.frame_id);
+  attachSupportPoints(out->measurements, out->segmentation, out->cloud, params_.max_support_points);
+  if (!frame.rgb.empty()) {
+    try {
+      colourSupportPoints(out->measurements, frame.rgb, k);
+    } catch (const std::invalid_argument& e) {
+      out->colour_problem = std::string("no colours: ") + e.what();  // the points stay uncoloured
+    }
+  }
+}
+
+SlamFrameResult QuadricSlam::backEnd(FrontEndFrame* front) {
+  SlamFrameResult out;
+  out.stamp = front->stamp;
+  if (!std::isfinite(front->stamp)) {
+    out.message = front->problem;
     return out;
   }
-  if (has_stamp_ && frame.stamp <= last_stamp_) {
+  // 1. The time rule, in frame order, before the frame is used (a skipped frame keeps the order
+  // as it was, as before the front end was split off).
+  if (has_stamp_ && front->stamp <= last_stamp_) {
     reset();
     out.reset = true;
   }
-  const CameraIntrinsics& k = frame.intrinsics;
-  const std::string size_problem = imageSizeProblem(k, frame.depth_m.cols, frame.depth_m.rows);
-  if (!size_problem.empty()) {
-    out.message = size_problem;
-    return out;
-  }
-  if (frame.depth_m.type() != CV_32FC1) {
-    out.message = "depth image must be CV_32FC1 metres";
+  if (!front->problem.empty()) {
+    out.message = front->problem;
     return out;
   }
   has_stamp_ = true;
-  last_stamp_ = frame.stamp;
+  last_stamp_ = front->stamp;
   out.processed = true;
+  out.message = front->colour_problem;
+  timer_.add("normals", front->normals_ms);
+  std::swap(cloud_, front->cloud);
+  segmentation_ = std::move(front->segmentation);
+  front->segmentation = Segmentation();
+  if (params_.mapping_enabled)
+    timer_.add("segmentation", front->segmentation_ms);
+  out.measurements = std::move(front->measurements);
+  const CameraIntrinsics& k = front->intrinsics;
 
-  timer_.time("normals", [&] {
-    normals_.compute(backProject(depthViewOf(frame.depth_m), k, params_.back_projection), cloud_);
-  });
-  segmentation_ = Segmentation();
-  if (params_.mapping_enabled) {
-    segmentation_ = timer_.time("segmentation", [&] { return segmenter_.segment(cloud_); });
-    out.measurements = toFrameMeasurements(segmentation_, frame.stamp, frame.frame_id);
-    attachSupportPoints(out.measurements, segmentation_, cloud_, params_.max_support_points);
-    if (!frame.rgb.empty()) {
-      try {
-        colourSupportPoints(out.measurements, frame.rgb, k);
-      } catch (const std::invalid_argument& e) {
-        out.message = std::string("no colours: ") + e.what();  // the points stay uncoloured
-      }
-    }
-  }
   // The segmentation's surfaces give the odometry a motion guess for large steps.
-  out.odometry = timer_.time("odometry", [&] {
-    return odometry_.track(cloud_, k, frame.stamp,
+  out.odometry = timeStage(timer_, "odometry", &out.odometry_ms, [&] {
+    return odometry_.track(cloud_, k, front->stamp,
                            params_.mapping_enabled ? &out.measurements.observations : nullptr);
   });
   out.tracking = odometry_.initialized();
@@ -137,8 +198,8 @@ SlamFrameResult QuadricSlam::process(const RgbdFrame& frame) {
 
   OdometryInput odometry_input;
   odometry_input.T_odom_camera = out.odometry.T_odom_camera;
-  out.mapping =
-      timer_.time("mapping", [&] { return mapper_.process(out.measurements, odometry_input); });
+  out.mapping = timeStage(timer_, "mapping", &out.mapping_ms,
+                          [&] { return mapper_.process(out.measurements, odometry_input); });
   out.mapped = out.mapping.status == FrameStatus::kOk;
   if (params_.batch_refinement && !batch_overflow_) {
     batch_recorder_.record(out.mapping, mapper_);

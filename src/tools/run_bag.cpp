@@ -20,11 +20,17 @@
 //                            candidates, reconstruction points (what a long run may grow) and
 //                            the heap in use (eval/resource_usage.h: resident memory less what
 //                            the allocator holds free)
+//   DIR/frames.csv           one line per processed frame, written as it comes: the odometry
+//                            status, the back end's times (odometry, mapping and within it
+//                            association, window optimisation, merging; ms), keyframe, landmarks,
+//                            window size: the cost over the run, e.g. its deciles
+//                            (scripts/bounded_cost)
 // With --gt prints the ATE and RPE of the odometry (ate_rmse_m ...) and of SLAM (map_ate_rmse_m
 // ...); with the batch refinement also the online SLAM's (online_map_ate_rmse_m ...), and the
-// refinement's size and time (batch_seconds). INPUT may also be a scene file (config/scenes/*.yaml): its frames are rendered as they are
-// needed (sim/synthetic_frame_source.h), so a sequence of any length runs without a bag; the truth
-// goes to DIR/groundtruth.txt and is used when --gt is not given.
+// refinement's size and time (batch_seconds). INPUT may also be a scene file
+// (config/scenes/*.yaml): its frames are rendered as they are needed
+// (sim/synthetic_frame_source.h), so a sequence of any length runs without a bag; the truth goes to
+// DIR/groundtruth.txt and is used when --gt is not given.
 //
 //   run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR] [--max-frames N]
 //           [--intrinsics fx,fy,cx,cy] [--quiet] [--sample-every N] [--no-rgb] [--no-batch]
@@ -36,6 +42,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <iomanip>
 #include <iostream>
 #include <map>
@@ -65,8 +72,11 @@ struct Options {
   std::string config_dir = QUADRIC_SLAM_CONFIG_DIR;
   bool odometry_only = false;
   bool quiet = false;
-  bool rgb = true;  // read RGB when the input has it (it colours the reconstruction only)
+  bool rgb = true;    // read RGB when the input has it (it colours the reconstruction only)
   bool batch = true;  // false: no batch refinement whatever mapping.yaml says
+  // Reading and the front end (normals, segmentation) of the next frame on a second thread while
+  // the back end (odometry, mapping) works on this one: the same results, sooner on 2+ cores.
+  bool pipelined = true;
   long max_frames = -1;
   long sample_every = 30;
   qs::CameraIntrinsics intrinsics;             // fx = 0: from the input
@@ -84,15 +94,20 @@ int usage(const std::string& problem) {
       << "usage: run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR]\n"
       << "               [--max-frames N] [--intrinsics fx,fy,cx,cy] [--quiet]\n"
       << "               [--sample-every N] [--no-rgb] [--no-batch] [--seconds S] [--rate HZ]\n"
-      << "               [--seed N]\n"
+      << "               [--seed N] [--sequential]\n"
       << "  INPUT: a TUM rosbag (.bag), a TUM folder (rgb.txt, depth.txt, depth/), or a scene\n"
       << "         file (config/scenes/*.yaml) rendered frame by frame: --seconds (default 60),\n"
       << "         --rate (default: the scene's), --seed (default 1) apply to it\n"
       << "  --sample-every N: a line of DIR/resources.csv every N frames (default 30)\n"
       << "  --no-rgb: depth only (by default RGB, when the input has it, colours the\n"
       << "            reconstruction; frames without an RGB partner run uncoloured)\n"
-      << "  --no-batch: no offline batch refinement (mapping.yaml batch_refinement): trajectory.txt\n"
-      << "              and map.yaml are the online estimates\n";
+      << "  --no-batch: no offline batch refinement (mapping.yaml batch_refinement): "
+         "trajectory.txt\n"
+      << "              and map.yaml are the online estimates\n"
+      << "  --sequential: one thread for the whole pipeline (by default the next frame is read "
+         "and\n"
+      << "                its normals and segmentation computed on a second thread meanwhile;\n"
+      << "                the results are the same)\n";
   return 2;
 }
 
@@ -117,6 +132,8 @@ bool parseOptions(int argc, char** argv, Options& o, std::string& problem) {
         o.odometry_only = true;
       } else if (arg == "--no-rgb") {
         o.rgb = false;
+      } else if (arg == "--sequential") {
+        o.pipelined = false;
       } else if (arg == "--no-batch") {
         o.batch = false;
       } else if (arg == "--quiet") {
@@ -283,6 +300,9 @@ int main(int argc, char** argv) {
     resources << "frames,stamp_s,elapsed_s,rss_mb,ms_per_frame,landmarks,candidates,"
                  "reconstruction_points,heap_in_use_mb\n";
     auto last_sample = std::chrono::steady_clock::now();
+    std::ofstream frames_csv(o.out_dir + "/frames.csv");
+    frames_csv << "frame,stamp_s,status,odometry_ms,mapping_ms,association_ms,optimisation_ms,"
+                  "merge_ms,keyframe,landmarks,window_keyframes,window_residuals\n";
     if (!o.quiet) {
       std::cerr << "run_bag: " << o.input << ": " << total << " frames, config " << o.config_dir
                 << (o.odometry_only ? ", odometry only" : "") << "\n";
@@ -305,10 +325,32 @@ int main(int argc, char** argv) {
     // How each measurement fared against the landmarks (AssociationOutcome, mapping/association.h).
     std::map<qs::AssociationOutcome, std::size_t> outcomes;
     const auto start = std::chrono::steady_clock::now();
-    qs::RgbdFrame frame;
-    while (frames < total && read_timer.time("read", [&] { return source->next(frame); })) {
+    // Two slots: the front end fills one (on its own thread when pipelined) while the back end
+    // takes the other. A frame's slot is not written again before its back end has run.
+    qs::RgbdFrame slot_frame[2];
+    qs::FrontEndFrame slot_front[2];
+    std::size_t read_count = 0;
+    auto readAndFrontEnd = [&](int slot) {
+      if (read_count >= total ||
+          !read_timer.time("read", [&] { return source->next(slot_frame[slot]); }))
+        return false;
+      ++read_count;
+      slam.frontEnd(slot_frame[slot], &slot_front[slot]);
+      return true;
+    };
+    auto startFrontEnd = [&](int slot) {
+      return std::async(o.pipelined ? std::launch::async : std::launch::deferred, readAndFrontEnd,
+                        slot);
+    };
+    int slot = 0;
+    std::future<bool> ahead = startFrontEnd(slot);
+    while (ahead.get()) {
+      const int current = slot;
+      slot = 1 - slot;
+      ahead = startFrontEnd(slot);
+      const qs::RgbdFrame& frame = slot_frame[current];
       ++frames;
-      const qs::SlamFrameResult result = slam.process(frame);
+      const qs::SlamFrameResult result = slam.backEnd(&slot_front[current]);
       resets += result.reset;
       if (result.reset)
         std::cerr << "\nrun_bag: time went backwards at " << frame.stamp << ": reset\n";
@@ -319,6 +361,17 @@ int main(int argc, char** argv) {
       }
       for (const qs::QuadricMeasurement& m : result.measurements.observations)
         ++observations_per_class[qs::toString(m.quadric_camera.quadricClass())];
+      {
+        const qs::MapperFrameResult& mapped = result.mapping;
+        frames_csv << frames << ',' << std::fixed << std::setprecision(6) << frame.stamp << ','
+                   << (result.tracking ? qs::toString(result.odometry.status) : "uninitialised")
+                   << ',' << std::setprecision(3) << result.odometry_ms << ',' << result.mapping_ms
+                   << ',' << 1e3 * mapped.association_seconds << ','
+                   << 1e3 * mapped.optimisation_seconds << ',' << 1e3 * mapped.merge_seconds << ','
+                   << (result.mapped && mapped.keyframe ? 1 : 0) << ','
+                   << slam.mapper().map().landmarks().size() << ',' << mapped.window.keyframes
+                   << ',' << mapped.window.residuals << '\n';
+      }
       ++status_counts[static_cast<int>(result.odometry.status)];
       frames_recovering += result.recovering ? 1 : 0;
       if (result.tracking) {
@@ -429,8 +482,8 @@ int main(int argc, char** argv) {
       std::map<int, qs::QuadricModel> surfaces;
       for (const qs::QuadricLandmark& landmark : landmarks)
         surfaces[landmark.id] = landmark.quadric_map;
-      pcl::fromROSMsg(
-          qs::reconstructionCloudMsg(slam.reconstruction().cloud(surfaces), header), points);
+      pcl::fromROSMsg(qs::reconstructionCloudMsg(slam.reconstruction().cloud(surfaces), header),
+                      points);
       if (!points.empty())
         pcl::io::savePCDFileBinary(o.out_dir + "/reconstruction.pcd", points);
       std::printf("map landmarks %zu:", landmarks.size());

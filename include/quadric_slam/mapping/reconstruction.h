@@ -3,10 +3,17 @@
 // estimate.
 //
 // Points are stored projected onto the landmark's surface, in its own quadric frame (as estimated
-// when they were added), one per voxel of that frame, so memory is bounded by the observed area
+// when they were added), one per cell of the surface, so memory is bounded by the observed area
 // rather than by the number of frames or the depth noise, and a landmark whose estimate moves
 // carries its points with it: cloud() places every point with the current T_map_quadric and
-// projects it onto the current surface (geometry/surface_distance.h). Each point may carry the RGB colour of the pixel it came from
+// projects it onto the current surface (geometry/surface_distance.h).
+// The cells are in coordinates of the surface itself, voxel_size on a side: a plane's in-plane
+// coordinates; azimuth and height along the axis for cylinders and cones, azimuth and elevation
+// for spheres, at angular steps set by the landmark's radius (cone: half angle) when its first
+// point came. So a patch seen again keeps its cell while the estimate converges (a radius that
+// grows by a centimetre, a plane merged with a parallel estimate of itself), where cells of the
+// quadric frame's 3D grid would give it a second layer of points each time. General quadrics use
+// the frame's 3D voxels. Each point may carry the RGB colour of the pixel it came from
 // (frontend/support_colours.h), packed 0xAARRGGBB, alpha 0 = uncoloured.
 #pragma once
 
@@ -28,13 +35,13 @@ namespace quadric_slam {
 class QuadricReconstruction {
  public:
   struct Params {
-    double voxel_size = 0.01;              // m: at most one point per voxel of a quadric frame, > 0
+    double voxel_size = 0.01;              // m: at most one point per cell of a surface, > 0
     int max_points_per_landmark = 100000;  // further points of a landmark are dropped, >= 1
     // Over the whole map, >= 1: memory stays bounded (about 100 bytes a point) even where the
     // observed area is not, e.g. a map grown over a whole building. Once full, further points
     // are dropped (full() says so); the landmarks themselves are still estimated and published.
     int max_points = 3000000;
-    double max_surface_distance = 0.05;    // m: points farther from the surface are outliers, > 0
+    double max_surface_distance = 0.05;  // m: points farther from the surface are outliers, > 0
     void validate() const;  // throws std::invalid_argument naming the field and its range
   };
 
@@ -45,8 +52,9 @@ class QuadricReconstruction {
   // landmark's current estimate in the map frame. Points that are not finite, or farther than
   // max_surface_distance from the surface (exact distance for the classes of revolution and planes,
   // first-order for general quadrics), are skipped, as are points in an occupied voxel and points
-  // beyond max_points_per_landmark or max_points. Returns how many points were stored. colours_rgba: one packed colour per point (alpha 0 = none), or empty
-  // for uncoloured points; a voxel keeps the colour of the point that occupied it first.
+  // beyond max_points_per_landmark or max_points. Returns how many points were stored.
+  // colours_rgba: one packed colour per point (alpha 0 = none), or empty for uncoloured points; a
+  // voxel keeps the colour of the point that occupied it first.
   int addPoints(int id, const QuadricModel& landmark_map, const Eigen::Isometry3d& T_map_camera,
                 const std::vector<Eigen::Vector3f>& points_camera,
                 const std::vector<std::uint32_t>& colours_rgba = {});
@@ -72,13 +80,18 @@ class QuadricReconstruction {
 
  private:
   struct LandmarkPoints {
-    std::unordered_set<std::uint64_t> voxels;  // packed integer voxel coordinates
+    QuadricClass quadric_class = QuadricClass::kGeneral;
+    // Radius (sphere, cylinder; m) or half angle (cone; rad) when the first point came: it sets
+    // the angular step of the cells for the landmark's whole life.
+    double reference_size = 0.0;
+    std::unordered_set<std::uint64_t> voxels;  // packed integer cell coordinates (cellKey)
     std::vector<Eigen::Vector3f> points_quadric;
     // rgba[i] is the colour of points_quadric[i]; it may be shorter (points beyond its end are
     // uncoloured), so code that appends points without colours keeps them aligned.
     std::vector<std::uint32_t> rgba;
   };
-  std::uint64_t voxelKey(const Eigen::Vector3d& p_quadric) const;
+  // The cell of a surface point (quadric frame) of a landmark's stored points.
+  std::uint64_t cellKey(const LandmarkPoints& stored, const Eigen::Vector3d& p_quadric) const;
 
   Params params_;
   SurfaceProjector projector_;

@@ -92,13 +92,40 @@ struct SlamFrameResult {
   // The relocalisation attempt of a recovering frame (attempted = false when none was needed).
   RecoveryRelocalisation relocalisation;
   MapperFrameResult mapping;
+  double odometry_ms = 0.0, mapping_ms = 0.0;  // wall time of the two stages (0: not run)
+};
+
+// What the front end (steps 2-4: checks, normals, segmentation) makes of one frame. It depends on
+// the frame alone, never on the odometry or the map, so the front end of the next frame may run on
+// another thread while the back end (steps 1, 5, 6) works on this one (scripts/run_bag
+// --pipelined). The storage is reused when the same object is filled again.
+struct FrontEndFrame {
+  double stamp = 0.0;
+  std::string frame_id;
+  CameraIntrinsics intrinsics;
+  std::string problem;  // not empty: the frame cannot be used (the back end skips it, saying why)
+  std::string colour_problem;  // not empty: the RGB image could not colour the supporting points
+  pcl::PointCloud<pcl::PointNormal> cloud;  // organized, with normals (camera frame)
+  Segmentation segmentation;
+  FrameMeasurements measurements;
+  double normals_ms = 0.0, segmentation_ms = 0.0;  // timed stages (segmentation 0 when not run)
 };
 
 class QuadricSlam {
  public:
   explicit QuadricSlam(const SlamParams& params);
 
+  // backEnd(frontEnd(frame)), on this thread.
   SlamFrameResult process(const RgbdFrame& frame);
+
+  // The front end: fills *out from the frame alone. It touches only the normal estimator and the
+  // segmenter (both const), so one thread may run it while another runs backEnd() on an earlier
+  // frame; two threads must not run frontEnd() at once on the same *out.
+  void frontEnd(const RgbdFrame& frame, FrontEndFrame* out) const;
+  // The back end, in frame order: the time rule, odometry, mapping, reconstruction, and the stage
+  // timings of the front end. Takes the frame's cloud and segmentation (cloud(), segmentation());
+  // *front is left holding the previous frame's storage, for reuse.
+  SlamFrameResult backEnd(FrontEndFrame* front);
 
   // Forgets odometry, map and reconstruction (landmark ids keep counting).
   void reset();
@@ -143,7 +170,10 @@ class QuadricSlam {
   double last_stamp_ = 0.0;
   // The mapper's latest map->odom correction (of the latest mapped frame).
   Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
-  pcl::PointCloud<pcl::PointNormal> cloud_;  // storage reused from frame to frame
+  pcl::PointCloud<pcl::PointNormal> cloud_;  // the latest frame's
+  // process(): the storage of the frame before, which the next front end fills (no allocation of
+  // a cloud per frame).
+  pcl::PointCloud<pcl::PointNormal> spare_cloud_;
   Segmentation segmentation_;
 };
 

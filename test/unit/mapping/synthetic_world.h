@@ -7,12 +7,12 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
 #include "../test_support.h"
-#include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/quadric.h"
 #include "quadric_slam/geometry/quadric_classes.h"
 #include "quadric_slam/geometry/shapes.h"
@@ -20,6 +20,7 @@
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/mapping/extent_box.h"
 #include "quadric_slam/mapping/landmark.h"
+#include "quadric_slam/types/observation.h"
 
 namespace quadric_slam {
 namespace test {
@@ -237,6 +238,40 @@ inline MapFileQuadric toMapFile(int id, const QuadricModel& q, int observations)
   out.scale = q.scale();
   out.shape = shapeMap(q);
   return out;
+}
+
+// The map file of the true landmarks (ids = their indices in `world`), for eval/map_metrics.h.
+inline MapFile truthMap(const std::vector<TrueLandmark>& world) {
+  MapFile map;
+  for (size_t i = 0; i < world.size(); ++i)
+    map.quadrics.push_back(toMapFile(static_cast<int>(i), world[i].quadric_world, 0));
+  return map;
+}
+
+// The map file of estimated landmarks (e.g. QuadricMapper::landmarks(), a batch solution's).
+inline MapFile estimateMap(const std::vector<QuadricLandmark>& landmarks) {
+  MapFile map;
+  for (const QuadricLandmark& l : landmarks)
+    map.quadrics.push_back(toMapFile(l.id, l.quadric_map, l.observations));
+  return map;
+}
+
+// A piece of the wall x = 3 (normal -x) over world y in [y0, y1], z in [z0, z1], in a frame of its
+// own: the segmenter reports a large surface as such fragments.
+inline TrueLandmark wallPiece(double y0, double y1, double z0 = 0.0, double z1 = 2.5) {
+  return plane(Eigen::Vector3d(3.0, 0.5 * (y0 + y1), 0.5 * (z0 + z1)), -Eigen::Vector3d::UnitX(),
+               Eigen::Vector3d::UnitY(), 0.5 * (y1 - y0), 0.5 * (z1 - z0));
+}
+
+// The camera 3 m from the wall of wallPiece at 1.3 m height, looking at it (+x) and a little down,
+// sliding along y from y_from to y_to over `frames` frames.
+inline std::vector<Eigen::Isometry3d> slideAlongWall(int frames, double y_from, double y_to) {
+  std::vector<Eigen::Isometry3d> poses;
+  for (int i = 0; i < frames; ++i) {
+    const double y = y_from + (y_to - y_from) * i / std::max(frames - 1, 1);
+    poses.push_back(lookAlong(Eigen::Vector3d(0, y, 1.3), Eigen::Vector3d(1, 0, -0.25)));
+  }
+  return poses;
 }
 
 }  // namespace test

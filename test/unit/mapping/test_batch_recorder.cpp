@@ -21,22 +21,6 @@ namespace {
 const Eigen::Vector3d kUnitX = Eigen::Vector3d::UnitX(), kUnitY = Eigen::Vector3d::UnitY(),
                       kUnitZ = Eigen::Vector3d::UnitZ();
 
-// A piece of the wall x = 3 (normal -x) over world y in [y0, y1], z in [z0, z1].
-test::TrueLandmark wallPiece(double y0, double y1, double z0, double z1) {
-  return test::plane(Eigen::Vector3d(3.0, 0.5 * (y0 + y1), 0.5 * (z0 + z1)), -kUnitX, kUnitY,
-                     0.5 * (y1 - y0), 0.5 * (z1 - z0));
-}
-
-// The camera 3 m from the wall at 1.3 m height, looking at it and a little down, sliding along y.
-std::vector<Eigen::Isometry3d> slideAlongWall(int frames, double y_from, double y_to) {
-  std::vector<Eigen::Isometry3d> poses;
-  for (int i = 0; i < frames; ++i) {
-    const double y = y_from + (y_to - y_from) * i / std::max(frames - 1, 1);
-    poses.push_back(test::lookAlong(Eigen::Vector3d(0, y, 1.3), Eigen::Vector3d(1, 0, -0.25)));
-  }
-  return poses;
-}
-
 std::map<int, int> observationsPerLandmark(const BatchRecorder& recorder) {
   std::map<int, int> out;
   for (const RecordedKeyframe& keyframe : recorder.keyframes())
@@ -54,13 +38,13 @@ TEST(BatchRecorder, ObservationsOfAMergedLandmarkGoToItsSurvivor) {
   std::vector<std::vector<test::TrueLandmark>> pieces;
   for (int i = 0; i < 36; ++i) {
     if (i < 12)
-      pieces.push_back({wallPiece(-3.5, -2.0, 0.5, 2.0), floor});
+      pieces.push_back({test::wallPiece(-3.5, -2.0, 0.5, 2.0), floor});
     else if (i < 24)
-      pieces.push_back({wallPiece(2.0, 3.5, 0.5, 2.0), floor});
+      pieces.push_back({test::wallPiece(2.0, 3.5, 0.5, 2.0), floor});
     else
-      pieces.push_back({wallPiece(-2.2, 2.2, 0.5, 2.0), floor});
+      pieces.push_back({test::wallPiece(-2.2, 2.2, 0.5, 2.0), floor});
   }
-  const std::vector<Eigen::Isometry3d> poses = slideAlongWall(36, -0.3, 0.3);
+  const std::vector<Eigen::Isometry3d> poses = test::slideAlongWall(36, -0.3, 0.3);
   std::mt19937 rng(63);
   QuadricMapper::Params params;
   params.window.size = 4;  // the parts' first keyframes leave the window before the merge

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <random>
 
+#include "map_report_checks.h"
 #include "quadric_slam/eval/map_metrics.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
 #include "quadric_slam/mapping/batch_recorder.h"
@@ -51,29 +52,6 @@ RecordedRun runAndRecord(QuadricMapper* mapper, const std::vector<test::TrueLand
   }
   out.recorder.recordMerges(mapper->mergeDuplicates());
   return out;
-}
-
-MapFile truthMap(const std::vector<test::TrueLandmark>& world) {
-  MapFile map;
-  for (size_t i = 0; i < world.size(); ++i)
-    map.quadrics.push_back(test::toMapFile(static_cast<int>(i), world[i].quadric_world, 0));
-  return map;
-}
-
-MapFile estimateMap(const std::vector<QuadricLandmark>& landmarks) {
-  MapFile map;
-  for (const QuadricLandmark& l : landmarks)
-    map.quadrics.push_back(test::toMapFile(l.id, l.quadric_map, l.observations));
-  return map;
-}
-
-double meanError(const MapReport& report, const std::string& quadric_class,
-                 const std::string& name) {
-  for (const ShapeError& e : report.classes.at(quadric_class).mean_errors)
-    if (e.name == name)
-      return e.value;
-  ADD_FAILURE() << "no " << name << " for " << quadric_class;
-  return 1e9;
 }
 
 TEST(BatchRefiner, ParamsValidate) {
@@ -174,9 +152,9 @@ TEST(BatchRefiner, RefinedTrajectoryBeatsTheOnlineWindowAndLandmarksConverge) {
   // about it free, which would tilt every surface alike).
   const MapEvaluator evaluator;
   const MapReport refined_map =
-      evaluator.evaluate(truthMap(world), estimateMap(solution.landmarks), poses[0]);
+      evaluator.evaluate(test::truthMap(world), test::estimateMap(solution.landmarks), poses[0]);
   const MapReport online_map =
-      evaluator.evaluate(truthMap(world), estimateMap(mapper.landmarks()), poses[0]);
+      evaluator.evaluate(test::truthMap(world), test::estimateMap(mapper.landmarks()), poses[0]);
   std::cout << "refined map:\n"
             << formatMapReport(refined_map) << "online map:\n"
             << formatMapReport(online_map);
@@ -187,16 +165,16 @@ TEST(BatchRefiner, RefinedTrajectoryBeatsTheOnlineWindowAndLandmarksConverge) {
   // 0.4 mm, cylinder axes 0.20 deg / 2.0 cm / radii 0.5 mm, cone apices 2.0 cm / axes 0.20 deg /
   // half-angles 0.05 deg (the positions drift along the corridor with the odometry's scale error,
   // which no surface in view can observe).
-  EXPECT_LT(meanError(refined_map, "plane", "normal_angle_deg"), 0.35);
-  EXPECT_LT(meanError(refined_map, "plane", "offset_m"), 0.005);
-  EXPECT_LT(meanError(refined_map, "sphere", "center_m"), 0.03);
-  EXPECT_LT(meanError(refined_map, "sphere", "radius_m"), 0.001);
-  EXPECT_LT(meanError(refined_map, "cylinder", "axis_angle_deg"), 0.3);
-  EXPECT_LT(meanError(refined_map, "cylinder", "axis_distance_m"), 0.03);
-  EXPECT_LT(meanError(refined_map, "cylinder", "radius_m"), 0.001);
-  EXPECT_LT(meanError(refined_map, "cone", "apex_m"), 0.03);
-  EXPECT_LT(meanError(refined_map, "cone", "axis_angle_deg"), 0.3);
-  EXPECT_LT(meanError(refined_map, "cone", "half_angle_deg"), 0.1);
+  EXPECT_LT(test::meanError(refined_map, "plane", "normal_angle_deg"), 0.35);
+  EXPECT_LT(test::meanError(refined_map, "plane", "offset_m"), 0.005);
+  EXPECT_LT(test::meanError(refined_map, "sphere", "center_m"), 0.03);
+  EXPECT_LT(test::meanError(refined_map, "sphere", "radius_m"), 0.001);
+  EXPECT_LT(test::meanError(refined_map, "cylinder", "axis_angle_deg"), 0.3);
+  EXPECT_LT(test::meanError(refined_map, "cylinder", "axis_distance_m"), 0.03);
+  EXPECT_LT(test::meanError(refined_map, "cylinder", "radius_m"), 0.001);
+  EXPECT_LT(test::meanError(refined_map, "cone", "apex_m"), 0.03);
+  EXPECT_LT(test::meanError(refined_map, "cone", "axis_angle_deg"), 0.3);
+  EXPECT_LT(test::meanError(refined_map, "cone", "half_angle_deg"), 0.1);
   // Where the surfaces are is better known after the batch than online (online, seed 102: plane
   // offsets 8.3 mm, sphere centres 2.4 cm, cylinder axes 2.6 cm, cone apices 2.5 cm).
   for (const auto& [quadric_class, position] :
@@ -204,8 +182,8 @@ TEST(BatchRefiner, RefinedTrajectoryBeatsTheOnlineWindowAndLandmarksConverge) {
                                                         {"sphere", "center_m"},
                                                         {"cylinder", "axis_distance_m"},
                                                         {"cone", "apex_m"}})
-    EXPECT_LT(meanError(refined_map, quadric_class, position),
-              meanError(online_map, quadric_class, position))
+    EXPECT_LT(test::meanError(refined_map, quadric_class, position),
+              test::meanError(online_map, quadric_class, position))
         << quadric_class;
   // Refined covariances: one per landmark, of its class's minimal size.
   for (const QuadricLandmark& l : solution.landmarks)

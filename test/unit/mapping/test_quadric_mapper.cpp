@@ -10,6 +10,7 @@
 #include <iostream>
 #include <random>
 
+#include "map_report_checks.h"
 #include "quadric_slam/eval/map_metrics.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
@@ -55,29 +56,6 @@ SyntheticRun run(QuadricMapper* mapper, const std::vector<test::TrueLandmark>& w
     out.mapper.push_back({frame.stamp, r.T_map_camera});
   }
   return out;
-}
-
-MapFile truthMap(const std::vector<test::TrueLandmark>& world) {
-  MapFile map;
-  for (size_t i = 0; i < world.size(); ++i)
-    map.quadrics.push_back(test::toMapFile(static_cast<int>(i), world[i].quadric_world, 0));
-  return map;
-}
-
-MapFile estimateMap(const QuadricMapper& mapper) {
-  MapFile map;
-  for (const QuadricLandmark& l : mapper.landmarks())
-    map.quadrics.push_back(test::toMapFile(l.id, l.quadric_map, l.observations));
-  return map;
-}
-
-double meanError(const MapReport& report, const std::string& quadric_class,
-                 const std::string& name) {
-  for (const ShapeError& e : report.classes.at(quadric_class).mean_errors)
-    if (e.name == name)
-      return e.value;
-  ADD_FAILURE() << "no " << name << " for " << quadric_class;
-  return 1e9;
 }
 
 TEST(QuadricMapper, ParamsValidate) {
@@ -129,8 +107,8 @@ TEST(QuadricMapper, LoopBeatsOdometryAndLandmarksConverge) {
   EXPECT_LT(ate_mapper.rmse(), 0.2 * ate_odometry.rmse());
   EXPECT_LT(ate_mapper.rmse(), 0.04);
 
-  const MapReport report =
-      MapEvaluator().evaluate(truthMap(world), estimateMap(mapper), ate_mapper.T_gt_est);
+  const MapReport report = MapEvaluator().evaluate(
+      test::truthMap(world), test::estimateMap(mapper.landmarks()), ate_mapper.T_gt_est);
   std::cout << formatMapReport(report);
   for (size_t l = 0; l < world.size(); ++l)
     EXPECT_GE(r.times_seen[l], 10) << "truth " << l << " hardly visible: fix the test world";
@@ -141,16 +119,16 @@ TEST(QuadricMapper, LoopBeatsOdometryAndLandmarksConverge) {
   // Mean errors per class in the ATE-aligned map (seeds 1-6: at most 0.23 deg / 1.3 cm for planes,
   // 3.8 cm / 2.8 mm for spheres, 0.29 deg / 2.6 cm / 1.4 mm for cylinders, 3.2 cm / 0.29 deg /
   // 0.27 deg for cones): the map is as good as the trajectory it was built from.
-  EXPECT_LT(meanError(report, "plane", "normal_angle_deg"), 0.5);
-  EXPECT_LT(meanError(report, "plane", "offset_m"), 0.025);
-  EXPECT_LT(meanError(report, "sphere", "center_m"), 0.05);
-  EXPECT_LT(meanError(report, "sphere", "radius_m"), 0.006);
-  EXPECT_LT(meanError(report, "cylinder", "axis_angle_deg"), 0.5);
-  EXPECT_LT(meanError(report, "cylinder", "axis_distance_m"), 0.04);
-  EXPECT_LT(meanError(report, "cylinder", "radius_m"), 0.005);
-  EXPECT_LT(meanError(report, "cone", "apex_m"), 0.05);
-  EXPECT_LT(meanError(report, "cone", "axis_angle_deg"), 0.5);
-  EXPECT_LT(meanError(report, "cone", "half_angle_deg"), 0.5);
+  EXPECT_LT(test::meanError(report, "plane", "normal_angle_deg"), 0.5);
+  EXPECT_LT(test::meanError(report, "plane", "offset_m"), 0.025);
+  EXPECT_LT(test::meanError(report, "sphere", "center_m"), 0.05);
+  EXPECT_LT(test::meanError(report, "sphere", "radius_m"), 0.006);
+  EXPECT_LT(test::meanError(report, "cylinder", "axis_angle_deg"), 0.5);
+  EXPECT_LT(test::meanError(report, "cylinder", "axis_distance_m"), 0.04);
+  EXPECT_LT(test::meanError(report, "cylinder", "radius_m"), 0.005);
+  EXPECT_LT(test::meanError(report, "cone", "apex_m"), 0.05);
+  EXPECT_LT(test::meanError(report, "cone", "axis_angle_deg"), 0.5);
+  EXPECT_LT(test::meanError(report, "cone", "half_angle_deg"), 0.5);
   for (const QuadricLandmark& l : mapper.landmarks()) {
     EXPECT_GE(l.observations, mapper.params().map.min_observations);
     EXPECT_GT(l.last_observed, 1.0);
@@ -487,13 +465,6 @@ TEST(QuadricMapper, LoadLandmarksRefusesBadInputAndKeepsTheMap) {
 const Eigen::Vector3d kUnitX = Eigen::Vector3d::UnitX(), kUnitY = Eigen::Vector3d::UnitY(),
                       kUnitZ = Eigen::Vector3d::UnitZ();
 
-// A piece of the wall x = 3 (normal -x) over world y in [y0, y1], z in [z0, z1], in a frame of its
-// own: the segmenter reports a large surface as such fragments.
-test::TrueLandmark wallPiece(double y0, double y1, double z0 = 0.0, double z1 = 2.5) {
-  return test::plane(Eigen::Vector3d(3.0, 0.5 * (y0 + y1), 0.5 * (z0 + z1)), -kUnitX, kUnitY,
-                     0.5 * (y1 - y0), 0.5 * (z1 - z0));
-}
-
 // Points on a surface piece on a 5 cm grid of its extent (planes: the y-z plane of the frame),
 // in the camera frame: the measurement's supporting points for the reconstruction.
 std::vector<Eigen::Vector3f> planePoints(const test::TrueLandmark& piece,
@@ -504,17 +475,6 @@ std::vector<Eigen::Vector3f> planePoints(const test::TrueLandmark& piece,
     for (double z = piece.extent.min.z(); z <= piece.extent.max.z(); z += 0.05)
       points.push_back((T_camera_quadric * Eigen::Vector3d(0, y, z)).cast<float>());
   return points;
-}
-
-// The camera 3 m from the wall at 1.3 m height, looking at it (+x) and a little down, sliding
-// along y from y_from to y_to over `frames` frames.
-std::vector<Eigen::Isometry3d> slideAlongWall(int frames, double y_from, double y_to) {
-  std::vector<Eigen::Isometry3d> poses;
-  for (int i = 0; i < frames; ++i) {
-    const double y = y_from + (y_to - y_from) * i / std::max(frames - 1, 1);
-    poses.push_back(test::lookAlong(Eigen::Vector3d(0, y, 1.3), Eigen::Vector3d(1, 0, -0.25)));
-  }
-  return poses;
 }
 
 // Frame by frame: the pieces of `pieces_per_frame[i]` measured from poses[i] (with supporting
@@ -576,12 +536,13 @@ std::vector<int> planesAt(const QuadricMapper& mapper, const Eigen::Isometry3d& 
 // and association is one-to-one, so two pieces start candidates of their own each time. With
 // merging the wall is one landmark after 20 frames; without it is three or more.
 TEST(QuadricMapper, WallSeenAsThreeFragmentsOverTwentyFramesIsOneLandmark) {
-  const std::vector<Eigen::Isometry3d> poses = slideAlongWall(20, -0.3, 0.3);
+  const std::vector<Eigen::Isometry3d> poses = test::slideAlongWall(20, -0.3, 0.3);
   const test::TrueLandmark floor =
       test::plane(Eigen::Vector3d(1.5, 0, 0), kUnitZ, kUnitX, 1.5, 2.0);
   const test::TrueLandmark ball = test::sphere(Eigen::Vector3d(2.0, 0.8, 0.3), 0.2);
-  const std::vector<test::TrueLandmark> pieces = {wallPiece(-2.0, -0.72), wallPiece(-0.66, 0.6),
-                                                  wallPiece(0.65, 2.0), floor, ball};
+  const std::vector<test::TrueLandmark> pieces = {test::wallPiece(-2.0, -0.72),
+                                                  test::wallPiece(-0.66, 0.6),
+                                                  test::wallPiece(0.65, 2.0), floor, ball};
   for (const bool merging : {true, false}) {
     QuadricMapper::Params p;
     p.map.merging.enabled = merging;
@@ -613,7 +574,7 @@ TEST(QuadricMapper, WallSeenAsThreeFragmentsOverTwentyFramesIsOneLandmark) {
 // at random about the normal, whose axis-aligned boxes are up to 1.4 times wider, and association
 // grows each box by 0.25 m.)
 TEST(QuadricMapper, TwoTablesAtOneHeightTwoMetresApartStayTwoLandmarks) {
-  const std::vector<Eigen::Isometry3d> poses = slideAlongWall(20, -0.3, 0.3);
+  const std::vector<Eigen::Isometry3d> poses = test::slideAlongWall(20, -0.3, 0.3);
   const test::TrueLandmark left =
       test::plane(Eigen::Vector3d(2.0, -1.4, 0.75), kUnitZ, kUnitX, 0.4, 0.4);
   const test::TrueLandmark right =
@@ -621,10 +582,10 @@ TEST(QuadricMapper, TwoTablesAtOneHeightTwoMetresApartStayTwoLandmarks) {
   const test::TrueLandmark floor =
       test::plane(Eigen::Vector3d(1.5, 0, 0), kUnitZ, kUnitX, 1.5, 2.0);
   QuadricMapper mapper;
-  runScript(
-      &mapper, poses,
-      std::vector<std::vector<test::TrueLandmark>>(20, {left, right, floor, wallPiece(-2, 2)}),
-      true, 62);
+  runScript(&mapper, poses,
+            std::vector<std::vector<test::TrueLandmark>>(
+                20, {left, right, floor, test::wallPiece(-2, 2)}),
+            true, 62);
   EXPECT_TRUE(mapper.mergeDuplicates().empty());
   const std::vector<int> tables = planesAt(mapper, poses[0], kUnitZ, 0.75);
   ASSERT_EQ(tables.size(), 2u);
@@ -652,16 +613,16 @@ TEST(QuadricMapper, LandmarksFoundToBeOneSurfaceAreMergedAndReported) {
   std::vector<std::vector<test::TrueLandmark>> pieces;
   for (int i = 0; i < 36; ++i) {
     if (i < 12)
-      pieces.push_back({wallPiece(-3.5, -2.0, 0.5, 2.0), floor});
+      pieces.push_back({test::wallPiece(-3.5, -2.0, 0.5, 2.0), floor});
     else if (i < 24)
-      pieces.push_back({wallPiece(2.0, 3.5, 0.5, 2.0), floor});
+      pieces.push_back({test::wallPiece(2.0, 3.5, 0.5, 2.0), floor});
     else
-      pieces.push_back({wallPiece(-2.2, 2.2, 0.5, 2.0), floor});
+      pieces.push_back({test::wallPiece(-2.2, 2.2, 0.5, 2.0), floor});
   }
   QuadricMapper mapper;
   // Exact odometry: the two parts are estimated from different frames, and a drift the walls and
   // the floor cannot observe (yaw, sliding along the wall) would tell them apart.
-  const std::vector<Eigen::Isometry3d> poses = slideAlongWall(36, -0.3, 0.3);
+  const std::vector<Eigen::Isometry3d> poses = test::slideAlongWall(36, -0.3, 0.3);
   ScriptedRun run = runScript(&mapper, poses, pieces, false, 63);
   std::vector<LandmarkMerge> merges;
   for (const MapperFrameResult& f : run.frames)

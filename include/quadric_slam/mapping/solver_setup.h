@@ -1,0 +1,29 @@
+// What the sliding window (mapping/window.h) and the offline batch (mapping/batch_refiner.h) set up
+// alike on Ceres: the solver options (Schur elimination of the landmarks, one thread, silent) and
+// the landmarks' marginal covariances after a solve.
+#pragma once
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Core>
+#include <map>
+
+namespace quadric_slam {
+
+// Sparse Schur (the landmarks are eliminated first), one thread (the pipeline's other stages own
+// the other cores), no output; the caller picks the trust-region strategy.
+ceres::Solver::Options landmarkSolverOptions(int max_iterations);
+
+// One landmark's parameter block in a solved problem and the size of its minimal tangent.
+struct LandmarkBlock {
+  const double* parameters = nullptr;
+  int minimal_size = 0;
+};
+
+// The marginal covariances of `landmarks` (id -> block) in their minimal tangent spaces, symmetric
+// and positive definite; an id whose block Ceres cannot give (e.g. a gauge left free) is left out,
+// and all are when the problem is rank-deficient.
+std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
+                                                   const std::map<int, LandmarkBlock>& landmarks);
+
+}  // namespace quadric_slam

@@ -1,0 +1,45 @@
+#include "quadric_slam/mapping/solver_setup.h"
+
+#include <Eigen/Cholesky>
+#include <utility>
+#include <vector>
+
+namespace quadric_slam {
+
+ceres::Solver::Options landmarkSolverOptions(int max_iterations) {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::SPARSE_SCHUR;
+  options.max_num_iterations = max_iterations;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  return options;
+}
+
+std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
+                                                   const std::map<int, LandmarkBlock>& landmarks) {
+  std::map<int, Eigen::MatrixXd> out;
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (const auto& [id, block] : landmarks)
+    pairs.emplace_back(block.parameters, block.parameters);
+  if (pairs.empty() || !covariance.Compute(pairs, problem))
+    return out;
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  for (const auto& [id, block] : landmarks) {
+    RowMajor c(block.minimal_size, block.minimal_size);
+    if (!covariance.GetCovarianceBlockInTangentSpace(block.parameters, block.parameters,
+                                                     c.data()) ||
+        !c.allFinite())
+      continue;
+    const Eigen::MatrixXd symmetric = 0.5 * (c + c.transpose());
+    if (Eigen::LLT<Eigen::MatrixXd>(symmetric).info() == Eigen::Success)
+      out[id] = symmetric;
+  }
+  return out;
+}
+
+}  // namespace quadric_slam
