@@ -54,7 +54,7 @@ void attachSupportPoints(FrameMeasurements& frame, const Segmentation& segmentat
     if (label > 0 && label <= std::numeric_limits<std::uint16_t>::max())
       observation_of_label[label] = i + 1;
   }
-  std::vector<int> count(frame.observations.size(), 0), seen(frame.observations.size(), 0);
+  std::vector<int> count(frame.observations.size(), 0);
   for (int v = 0; v < labels.rows; ++v) {
     const std::uint16_t* row = labels.ptr<std::uint16_t>(v);
     for (int u = 0; u < labels.cols; ++u)
@@ -62,6 +62,7 @@ void attachSupportPoints(FrameMeasurements& frame, const Segmentation& segmentat
         ++count[o - 1];
   }
   std::vector<int> stride(frame.observations.size(), 1);
+  std::vector<int> until_next(frame.observations.size(), 1);  // the first pixel is taken
   for (std::size_t i = 0; i < frame.observations.size(); ++i) {
     stride[i] = std::max(1, (count[i] + max_points - 1) / max_points);
     frame.observations[i].support_points.clear();
@@ -75,9 +76,12 @@ void attachSupportPoints(FrameMeasurements& frame, const Segmentation& segmentat
         continue;
       const std::size_t i = o - 1;
       QuadricMeasurement& m = frame.observations[i];
+      // Every stride-th pixel of the observation (a countdown: no division per pixel).
+      if (--until_next[i] > 0)
+        continue;
+      until_next[i] = stride[i];
       const Eigen::Vector3f p = cloud(u, v).getVector3fMap();
-      if (seen[i]++ % stride[i] == 0 && p.allFinite() &&
-          static_cast<int>(m.support_points.size()) < max_points)
+      if (p.allFinite() && static_cast<int>(m.support_points.size()) < max_points)
         m.support_points.push_back(p);
     }
   }

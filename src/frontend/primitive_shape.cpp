@@ -118,7 +118,7 @@ PrimitiveShape PrimitiveShape::fromQuadric(const QuadricModel& q) {
   }
 }
 
-double PrimitiveShape::distance(const Eigen::Vector3d& p) const {
+double PrimitiveShape::curvedDistance(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d v = p - point;
   switch (quadric_class) {
     case QuadricClass::kPlane:
@@ -137,7 +137,7 @@ double PrimitiveShape::distance(const Eigen::Vector3d& p) const {
   }
 }
 
-Eigen::Vector3d PrimitiveShape::normalAt(const Eigen::Vector3d& p) const {
+Eigen::Vector3d PrimitiveShape::curvedNormalAt(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d v = p - point;
   switch (quadric_class) {
     case QuadricClass::kPlane:

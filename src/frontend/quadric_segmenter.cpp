@@ -792,7 +792,9 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
         double best_distance = threshold;
         for (int c = 0; c < 4; ++c) {
           const int label = candidates[c];
-          if (label == 0 || label == best)
+          // Inside a region the four samples share one label: each surface is measured once.
+          if (label == 0 || label == best || (c > 0 && label == candidates[c - 1]) ||
+              (c > 1 && label == candidates[c - 2]) || (c > 2 && label == candidates[0]))
             continue;
           const PrimitiveShape& shape = coarse.detections[label - 1].shape;
           const double distance = std::abs(shape.distance(point));

@@ -53,9 +53,17 @@ struct PrimitiveShape {
   // Signed geometric distance (m) of a point (same frame) to the surface: plane n.p - offset,
   // sphere |p - c| - r, cylinder (distance to axis) - r, cone rho cos(a) - z sin(a) in the cone
   // frame (exact near the nappe).
-  double distance(const Eigen::Vector3d& p) const;
+  // Planes (most calls: per pixel in the segmenter's upsampling and boundary passes) inline.
+  double distance(const Eigen::Vector3d& p) const {
+    return quadric_class == QuadricClass::kPlane ? direction.dot(p - point) : curvedDistance(p);
+  }
   // Unit surface normal at the foot of p (sign not meaningful).
-  Eigen::Vector3d normalAt(const Eigen::Vector3d& p) const;
+  Eigen::Vector3d normalAt(const Eigen::Vector3d& p) const {
+    return quadric_class == QuadricClass::kPlane ? direction : curvedNormalAt(p);
+  }
+  // distance() and normalAt() of the other classes.
+  double curvedDistance(const Eigen::Vector3d& p) const;
+  Eigen::Vector3d curvedNormalAt(const Eigen::Vector3d& p) const;
 
   // The same surface expressed in another frame: T_b_a maps points of this shape's frame a to b.
   PrimitiveShape transformed(const Eigen::Isometry3d& T_b_a) const;
