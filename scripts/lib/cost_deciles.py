@@ -26,7 +26,8 @@ def main():
         sys.exit(__doc__)
     out = sys.argv[1]
     with open(os.path.join(out, "frames.csv")) as f:
-        frames = list(csv.DictReader(f))
+        # A row cut short (a run still writing, or killed) is left out.
+        frames = [r for r in csv.DictReader(f) if None not in r.values()]
     if len(frames) < 10:
         sys.exit(f"cost_deciles: {len(frames)} frames in {out}/frames.csv, need at least 10")
     memory = []
