@@ -36,4 +36,18 @@ std::optional<PrimitiveShape> ellipsoidCandidate(const GeneralQuadricFit& fit,
   }
 }
 
+Eigen::MatrixXd ellipsoidModelCovariance(const QuadricModel& quadric, double sigma) {
+  const Eigen::Vector3d axes = semiAxes(quadric);
+  if (!(axes.minCoeff() > 0.0))
+    throw std::invalid_argument("ellipsoidModelCovariance: the quadric is not an ellipsoid");
+  if (!(sigma >= 0.0))
+    throw std::invalid_argument("ellipsoidModelCovariance: sigma must be >= 0 m");
+  Eigen::VectorXd variances(9);
+  const double rotation = sigma / axes.minCoeff();
+  variances << sigma * sigma, sigma * sigma, sigma * sigma, rotation * rotation,
+      rotation * rotation, rotation * rotation,
+      (sigma * quadric.scale().array().square()).square().matrix();
+  return variances.asDiagonal();
+}
+
 }  // namespace quadric_slam

@@ -523,6 +523,8 @@ void QuadricSegmenter::Params::validate() const {
   require(plane_rms_ratio >= 1, "plane_rms_ratio must be >= 1, got " + str(plane_rms_ratio));
   require(cylinder_rms_ratio >= 1,
           "cylinder_rms_ratio must be >= 1, got " + str(cylinder_rms_ratio));
+  require(general_model_sigma >= 0 && general_model_sigma <= 0.1,
+          "general_model_sigma must be in [0, 0.1] m, got " + str(general_model_sigma));
   require(max_rms_factor > 0 && max_rms_factor <= 10,
           "max_rms_factor must be in (0, 10], got " + str(max_rms_factor));
 }
@@ -936,6 +938,11 @@ Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& 
   boundary.distance_factor = params_.planes.distance_factor;
   boundary.min_distance = params_.planes.min_distance;
   completeBoundaryLabels(cloud, boundary, result);
+  // The model error of the general detections, added once their support (which scales the
+  // least-squares part) is final.
+  for (QuadricDetection& d : result.detections)
+    if (d.shape.quadric_class == QuadricClass::kGeneral && d.covariance.rows() == 9)
+      d.covariance += ellipsoidModelCovariance(d.shape.general_quadric, params_.general_model_sigma);
   result.timings.boundary_ms = msSince(start);
   return result;
 }

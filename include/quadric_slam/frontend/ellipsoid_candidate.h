@@ -26,4 +26,13 @@ bool plausibleEllipsoid(const QuadricModel& quadric, double min_semi_axis, doubl
 std::optional<PrimitiveShape> ellipsoidCandidate(const GeneralQuadricFit& fit,
                                                  double min_semi_axis, double max_semi_axis);
 
+// The model error of one view's ellipsoid as a covariance in its minimal tangent (general row of
+// Table II: rho, phi, scale), to be added to the least-squares covariance: a depth camera sees one
+// side of the surface with spatially correlated noise, so the fitted semi-axes stray by about
+// `sigma` (m) from view to view, far beyond sigma^2 (J^T J)^-1 of independent points.
+// Diagonal: translation sigma^2; rotation (sigma / smallest semi-axis)^2; scale (sigma s_i^2)^2
+// (s = 1 / semi-axis, so ds = da / a^2). Throws std::invalid_argument for a quadric that is not an
+// ellipsoid or sigma < 0.
+Eigen::MatrixXd ellipsoidModelCovariance(const QuadricModel& quadric, double sigma);
+
 }  // namespace quadric_slam

@@ -138,6 +138,11 @@ class QuadricSegmenter {
     // (ellipsoid_candidate.h): re-assigned, refined on its 9 minimal parameters (shape_refiner.h)
     // and held to max_rms_factor like the other curved shapes. Default true.
     bool detect_general = true;
+    // Model error of a general detection (m, [0, 0.1]): added to its least-squares covariance as
+    // ellipsoid_candidate.h's ellipsoidModelCovariance (translation, rotation and scale entries
+    // scaled from this 1-sigma error of the surface) so that the mapper's gates and weights see
+    // the view-to-view scatter of one-sided fits. Default 0.01.
+    double general_model_sigma = 0.01;
     // Largest fit RMS of a curved segment, relative to its distance threshold at the median
     // depth, (0, 10].
     double max_rms_factor = 0.6;

@@ -187,6 +187,10 @@ TEST(GeneralDetection, EllipsoidRenderedAloneIsOneGeneralDetection) {
                 1e-9 * d.covariance.cwiseAbs().maxCoeff());
       EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(d.covariance).eigenvalues().minCoeff(),
                 0.0);
+      // ... holding the model error of a one-sided view (general_model_sigma, 1 cm by default).
+      const Eigen::MatrixXd model = ellipsoidModelCovariance(d.shape.general_quadric, 0.01);
+      for (int i = 0; i < 9; ++i)
+        EXPECT_GE(d.covariance(i, i), model(i, i)) << "entry " << i;
       // The extent box is that of the supporting points in the quadric frame: inside the
       // ellipsoid's box, grown by the noise.
       EXPECT_TRUE((d.extent_max.array() <= semi_axes.array() + 0.02).all());
@@ -198,6 +202,26 @@ TEST(GeneralDetection, EllipsoidRenderedAloneIsOneGeneralDetection) {
   std::sort(errors.begin(), errors.end());
   std::printf("largest semi-axis error: median %.4f max %.4f m over %zu views\n",
               errors[errors.size() / 2], errors.back(), errors.size());
+}
+
+TEST(GeneralDetection, ParamsValidateAndModelCovarianceScales) {
+  QuadricSegmenter::Params p;
+  p.general_model_sigma = -0.001;
+  EXPECT_THROW(QuadricSegmenter{p}, std::invalid_argument);
+  p.general_model_sigma = 0.2;
+  EXPECT_THROW(QuadricSegmenter{p}, std::invalid_argument);
+  p.general_model_sigma = 0.0;
+  EXPECT_NO_THROW(QuadricSegmenter{p});
+  // sigma on translation, sigma / 0.07 on rotation, sigma / a^2 on each scale entry.
+  const QuadricModel cushion(QuadricClass::kGeneral, Eigen::Isometry3d::Identity(),
+                             Eigen::Vector3d(1 / 0.13, 1 / 0.08, 1 / 0.07),
+                             Eigen::Vector4d(1, 1, 1, -1));
+  const Eigen::MatrixXd C = ellipsoidModelCovariance(cushion, 0.01);
+  EXPECT_NEAR(std::sqrt(C(0, 0)), 0.01, 1e-15);
+  EXPECT_NEAR(std::sqrt(C(3, 3)), 0.01 / 0.07, 1e-12);
+  EXPECT_NEAR(std::sqrt(C(6, 6)), 0.01 / (0.13 * 0.13), 1e-9);
+  EXPECT_NEAR(std::sqrt(C(8, 8)), 0.01 / (0.07 * 0.07), 1e-9);
+  EXPECT_THROW(ellipsoidModelCovariance(QuadricModel(), 0.01), std::invalid_argument);  // a sphere
 }
 
 // The scene of test_quadric_segmenter.cpp: a floor, a wall, a sphere, an upright cylinder and an
