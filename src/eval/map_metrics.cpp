@@ -1,6 +1,7 @@
 #include "quadric_slam/eval/map_metrics.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -72,17 +73,40 @@ void requirePositive(double value, const char* name) {
   }
 }
 
+// An ellipsoid's semi-axes (1 / scale) and their directions (the columns of the quadric frame),
+// longest first.
+struct EllipsoidAxes {
+  Eigen::Vector3d lengths;
+  Eigen::Matrix3d directions;
+};
+
+EllipsoidAxes ellipsoidAxes(const MapFileQuadric& q) {
+  if (!q.scale.allFinite() || !(q.scale.minCoeff() > 0.0))
+    throw std::runtime_error("quadric " + std::to_string(q.id) +
+                             " (ellipsoid): scale must be finite and > 0");
+  const Eigen::Vector3d lengths = q.scale.cwiseInverse();
+  std::array<int, 3> order = {0, 1, 2};
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return lengths[a] > lengths[b]; });
+  EllipsoidAxes out;
+  for (int j = 0; j < 3; ++j) {
+    out.lengths[j] = lengths[order[j]];
+    out.directions.col(j) = q.T_map_quadric.linear().col(order[j]);
+  }
+  return out;
+}
+
 }  // namespace
 
 bool isEvaluatedClass(const std::string& quadric_class) {
   return quadric_class == "plane" || quadric_class == "sphere" || quadric_class == "cylinder" ||
-         quadric_class == "cone";
+         quadric_class == "cone" || quadric_class == "ellipsoid";
 }
 
 std::vector<ShapeError> shapeErrors(const MapFileQuadric& truth, const MapFileQuadric& estimate) {
   if (truth.quadric_class != estimate.quadric_class || !isEvaluatedClass(truth.quadric_class)) {
     throw std::invalid_argument(
-        "shapeErrors compares two plane/sphere/cylinder/cone quadrics of "
+        "shapeErrors compares two plane/sphere/cylinder/cone/ellipsoid quadrics of "
         "one class, got " +
         truth.quadric_class + " and " + estimate.quadric_class);
   }
@@ -109,6 +133,17 @@ std::vector<ShapeError> shapeErrors(const MapFileQuadric& truth, const MapFileQu
         {"axis_distance_m", distanceToLine(point(truth, "point"), point(estimate, "point"), a_e)},
         {"radius_m", std::abs(scalar(truth, "radius") - scalar(estimate, "radius"))}};
   }
+  if (c == "ellipsoid") {
+    // The frame's axis order is arbitrary (any relabelling is the same surface): compare the
+    // semi-axes sorted by length, and the directions of the longest axes.
+    const EllipsoidAxes t = ellipsoidAxes(truth), e = ellipsoidAxes(estimate);
+    return {{"center_m", (truth.T_map_quadric.translation() - estimate.T_map_quadric.translation())
+                             .norm()},
+            {"semi_axis_1_m", std::abs(t.lengths[0] - e.lengths[0])},
+            {"semi_axis_2_m", std::abs(t.lengths[1] - e.lengths[1])},
+            {"semi_axis_3_m", std::abs(t.lengths[2] - e.lengths[2])},
+            {"axis_angle_deg", lineAngleDeg(t.directions.col(0), e.directions.col(0))}};
+  }
   return {{"apex_m", (point(truth, "apex") - point(estimate, "apex")).norm()},
           {"axis_angle_deg", lineAngleDeg(direction(truth, "axis"), direction(estimate, "axis"))},
           {"half_angle_deg",
@@ -133,6 +168,8 @@ MapFileQuadric transformQuadric(const MapFileQuadric& quadric, const Eigen::Isom
   } else if (c == "cone") {
     setPoint(q, "apex", T_b_a * point(quadric, "apex"));
     setPoint(q, "axis", R * point(quadric, "axis"));
+  } else if (c == "ellipsoid" && q.shape.count("center")) {
+    setPoint(q, "center", T_b_a * point(quadric, "center"));
   }
   return q;
 }
@@ -148,6 +185,9 @@ void MapEvaluator::Params::validate() const {
   requirePositive(cone_apex_gate_m, "cone_apex_gate_m");
   requirePositive(cone_angle_gate_deg, "cone_angle_gate_deg");
   requirePositive(cone_half_angle_gate_deg, "cone_half_angle_gate_deg");
+  requirePositive(ellipsoid_center_gate_m, "ellipsoid_center_gate_m");
+  requirePositive(ellipsoid_semi_axis_gate_m, "ellipsoid_semi_axis_gate_m");
+  requirePositive(ellipsoid_angle_gate_deg, "ellipsoid_angle_gate_deg");
 }
 
 MapEvaluator::MapEvaluator(const Params& params) : params_(params) {
@@ -165,6 +205,10 @@ std::vector<double> MapEvaluator::gates(const std::string& quadric_class) const 
   }
   if (quadric_class == "cone") {
     return {p.cone_apex_gate_m, p.cone_angle_gate_deg, p.cone_half_angle_gate_deg};
+  }
+  if (quadric_class == "ellipsoid") {
+    return {p.ellipsoid_center_gate_m, p.ellipsoid_semi_axis_gate_m, p.ellipsoid_semi_axis_gate_m,
+            p.ellipsoid_semi_axis_gate_m, p.ellipsoid_angle_gate_deg};
   }
   throw std::invalid_argument("no gates for class '" + quadric_class + "'");
 }
@@ -281,6 +325,15 @@ std::map<int, double> truthRanges(const MapFile& truth,
         distances.push_back(std::abs(direction(q, "normal").dot(p) - scalar(q, "offset")));
       } else if (q.quadric_class == "sphere") {
         distances.push_back(std::abs((p - point(q, "center")).norm() - scalar(q, "radius")));
+      } else if (q.quadric_class == "ellipsoid") {
+        // Along the line to the centre: the surface is 1 / |S R^T u| from it in direction u.
+        const Eigen::Vector3d v = p - q.T_map_quadric.translation();
+        const double radius =
+            v.norm() > 0.0
+                ? 1.0 / q.scale.cwiseProduct(q.T_map_quadric.linear().transpose() * v.normalized())
+                            .norm()
+                : 0.0;
+        distances.push_back(std::abs(v.norm() - radius));
       } else {
         // Axial and radial coordinates of the camera about the axis.
         const bool cone = q.quadric_class == "cone";

@@ -1,10 +1,12 @@
 #include "quadric_slam/frontend/primitive_shape.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "quadric_slam/geometry/shapes.h"
+#include "quadric_slam/geometry/surface_distance.h"
 
 namespace quadric_slam {
 
@@ -44,6 +46,19 @@ PrimitiveShape PrimitiveShape::cone(const Eigen::Vector3d& apex, const Eigen::Ve
   return s;
 }
 
+PrimitiveShape PrimitiveShape::general(const QuadricModel& quadric) {
+  if (quadric.quadricClass() != QuadricClass::kGeneral)
+    throw std::invalid_argument("PrimitiveShape::general: the quadric is a " +
+                                toString(quadric.quadricClass()));
+  PrimitiveShape s;
+  s.quadric_class = QuadricClass::kGeneral;
+  s.general_quadric = quadric;
+  s.point = quadric.pose().translation();
+  s.direction = quadric.pose().linear().col(0);
+  s.size = 1.0 / quadric.scale()[0];
+  return s;
+}
+
 std::vector<double> PrimitiveShape::shapeVector() const {
   const Eigen::Vector3d& p = point;
   const Eigen::Vector3d& d = direction;
@@ -56,7 +71,7 @@ std::vector<double> PrimitiveShape::shapeVector() const {
     case QuadricClass::kCone:
       return {p.x(), p.y(), p.z(), d.x(), d.y(), d.z(), size};
     default:
-      throw std::invalid_argument("PrimitiveShape: class general has no primitive shape");
+      return {};
   }
 }
 
@@ -72,8 +87,10 @@ std::map<std::string, std::vector<double>> PrimitiveShape::schemaShape() const {
       return {{"point", p}, {"axis", d}, {"radius", {size}}};
     case QuadricClass::kCone:
       return {{"apex", p}, {"axis", d}, {"half_angle", {size}}};
-    default:
-      throw std::invalid_argument("PrimitiveShape: class general has no primitive shape");
+    default: {
+      const Eigen::Vector3d radii = general_quadric.scale().cwiseInverse();
+      return {{"center", p}, {"radii", {radii.x(), radii.y(), radii.z()}}};
+    }
   }
 }
 
@@ -88,7 +105,7 @@ QuadricModel PrimitiveShape::quadric() const {
     case QuadricClass::kCone:
       return quadricFromShape(ConeShape{point, direction, size});
     default:
-      throw std::invalid_argument("PrimitiveShape: class general has no primitive shape");
+      return general_quadric;
   }
 }
 
@@ -114,7 +131,7 @@ PrimitiveShape PrimitiveShape::fromQuadric(const QuadricModel& q) {
       return cone(s.apex, s.axis, s.half_angle);
     }
     default:
-      throw std::invalid_argument("PrimitiveShape: class general has no primitive shape");
+      return general(q);
   }
 }
 
@@ -132,8 +149,12 @@ double PrimitiveShape::curvedDistance(const Eigen::Vector3d& p) const {
       const double rho = (v - z * direction).norm();
       return rho * std::cos(size) - z * std::sin(size);
     }
-    default:
-      return 0.0;
+    default: {
+      // First-order distance f / |grad f| (Sampson); the floor keeps points at the centre, where
+      // the gradient vanishes, finite and far.
+      const double f = algebraicDistance(general_quadric, p);
+      return f / std::max(algebraicGradient(general_quadric, p).norm(), 1e-9);
+    }
   }
 }
 
@@ -151,8 +172,10 @@ Eigen::Vector3d PrimitiveShape::curvedNormalAt(const Eigen::Vector3d& p) const {
       const Eigen::Vector3d radial = (v - z * direction).normalized();
       return (std::cos(size) * radial - std::sin(size) * direction).normalized();
     }
-    default:
-      return Eigen::Vector3d::UnitZ();
+    default: {
+      const Eigen::Vector3d g = algebraicGradient(general_quadric, p);
+      return g.norm() > 0 ? Eigen::Vector3d(g.normalized()) : Eigen::Vector3d::UnitZ();
+    }
   }
 }
 
@@ -160,6 +183,8 @@ PrimitiveShape PrimitiveShape::transformed(const Eigen::Isometry3d& T_b_a) const
   PrimitiveShape s = *this;
   s.point = T_b_a * point;
   s.direction = T_b_a.linear() * direction;
+  if (quadric_class == QuadricClass::kGeneral)
+    s.general_quadric = general_quadric.transformed(T_b_a);
   return s;
 }
 
@@ -184,8 +209,7 @@ const std::vector<int>& minimalIndices(QuadricClass quadric_class) {
 }
 
 PrimitiveShape perturb(const PrimitiveShape& shape, const Eigen::VectorXd& delta) {
-  const std::vector<int>& indices = minimalIndices(shape.quadric_class);
-  if (delta.size() != static_cast<int>(indices.size())) {
+  if (delta.size() != minimalDimension(shape.quadric_class)) {
     throw std::invalid_argument("perturb: delta has the wrong dimension for the class");
   }
   // pi [+] dpi = (T exp(xi), S + D(s)) in the quadric frame (eqs. 9, 11, 16; Table II basis).

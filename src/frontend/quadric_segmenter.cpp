@@ -5,11 +5,14 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "quadric_slam/frontend/boundary_labels.h"
+#include "quadric_slam/frontend/central_quadric.h"
 #include "quadric_slam/frontend/cgal_shape_detector.h"
+#include "quadric_slam/frontend/ellipsoid_candidate.h"
 #include "quadric_slam/frontend/general_quadric_fit.h"
 #include "quadric_slam/frontend/parallel_chunks.h"
 #include "quadric_slam/geometry/symmetry.h"
@@ -206,6 +209,16 @@ ImageRoi grown(const ImageRoi& roi, int margin, int width, int height) {
   g.width = std::min(width, roi.x_offset + roi.width + margin) - g.x_offset;
   g.height = std::min(height, roi.y_offset + roi.height + margin) - g.y_offset;
   return g;
+}
+
+// The smallest box holding both.
+ImageRoi unite(const ImageRoi& a, const ImageRoi& b) {
+  ImageRoi u;
+  u.x_offset = std::min(a.x_offset, b.x_offset);
+  u.y_offset = std::min(a.y_offset, b.y_offset);
+  u.width = std::max(a.x_offset + a.width, b.x_offset + b.width) - u.x_offset;
+  u.height = std::max(a.y_offset + a.height, b.y_offset + b.height) - u.y_offset;
+  return u;
 }
 
 // Cylinder through the points around the cone's axis (the degenerate thin cone).
@@ -412,8 +425,44 @@ bool plausible(const PrimitiveShape& s, const QuadricSegmenter::Params& p) {
   }
 }
 
+// The ellipsoid of a segment whose shape test found shape residuals (general: the general quadric
+// fitted to its points): the fit's ellipsoid (ellipsoid_candidate.h), then twice the curved
+// shapes' re-assignment of the free pixels near it (in the candidate's roi) and a refinement of
+// its 9 minimal parameters on them. None when the fit is no plausible ellipsoid, the refinement
+// fails or leaves the plausible sizes, the support is too small, or the RMS exceeds the curved
+// shapes' limit (max_rms_factor). *indices receives the support.
+std::optional<ShapeRefiner::Result> detectEllipsoid(const Frame& frame,
+                                                    const GeneralQuadricFit& general,
+                                                    const ImageRoi& roi,
+                                                    const QuadricSegmenter::Params& p,
+                                                    const ShapeRefiner& refiner,
+                                                    std::vector<int>* indices) {
+  const std::optional<PrimitiveShape> start =
+      ellipsoidCandidate(general, p.min_sphere_radius, p.max_sphere_radius);
+  if (!start)
+    return std::nullopt;
+  ShapeRefiner::Result fit;
+  fit.shape = *start;
+  for (int pass = 0; pass < 2; ++pass) {
+    *indices = assignLargestComponent(frame, fit.shape, roi, p);
+    if (static_cast<int>(indices->size()) < p.min_curved_points)
+      return std::nullopt;
+    fit = refiner.refine(fit.shape, pointsOf(frame.cloud, *indices));
+    if (!fit.ok ||
+        !plausibleEllipsoid(fit.shape.general_quadric, p.min_sphere_radius, p.max_sphere_radius))
+      return std::nullopt;
+  }
+  const double z = medianDepth(frame.cloud, *indices);
+  if (fit.rms >
+      p.max_rms_factor * depthThreshold(z, p.planes.distance_factor, p.planes.min_distance))
+    return std::nullopt;
+  return fit;
+}
+
 // Moves a curved shape's origin to the foot of the supporting points' centroid on its axis (the
-// cylinder's point is free along the axis) so that extents are centred.
+// cylinder's point is free along the axis) so that extents are centred. A general quadric is put
+// in its canonical axis order (central_quadric.h) instead: the refinement may have swapped the
+// lengths of two axes.
 void centreOnSupport(PrimitiveShape& s, const std::vector<Eigen::Vector3d>& points) {
   if (points.empty())
     return;
@@ -425,6 +474,8 @@ void centreOnSupport(PrimitiveShape& s, const std::vector<Eigen::Vector3d>& poin
     s.point += s.direction.dot(mean - s.point) * s.direction;
   } else if (s.quadric_class == QuadricClass::kPlane) {
     s.point = mean - s.direction.dot(mean - s.point) * s.direction;
+  } else if (s.quadric_class == QuadricClass::kGeneral) {
+    s = PrimitiveShape::general(withCanonicalAxisOrder(s.general_quadric));
   }
 }
 
@@ -472,6 +523,8 @@ void QuadricSegmenter::Params::validate() const {
   require(plane_rms_ratio >= 1, "plane_rms_ratio must be >= 1, got " + str(plane_rms_ratio));
   require(cylinder_rms_ratio >= 1,
           "cylinder_rms_ratio must be >= 1, got " + str(cylinder_rms_ratio));
+  require(general_model_sigma >= 0 && general_model_sigma <= 0.1,
+          "general_model_sigma must be in [0, 0.1] m, got " + str(general_model_sigma));
   require(max_rms_factor > 0 && max_rms_factor <= 10,
           "max_rms_factor must be in (0, 10], got " + str(max_rms_factor));
 }
@@ -510,7 +563,8 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     (void)shape;
     detection.covariance = fit.covariance;
     // The fit's covariance is about fit.shape.quadric(); re-centring moves the frame by a symmetry
-    // element G (a slide along the cylinder axis), so re-express it: C' = M C M^T, M = Ad(G^-1).
+    // element G (a slide along the cylinder axis; a relabelling of a general quadric's axes), so
+    // re-express it: C' = M C M^T, M = Ad(G^-1).
     const Eigen::Isometry3d G =
         fit.shape.quadric().pose().inverse() * detection.shape.quadric().pose();
     const int k = minimalDimension(detection.shape.quadric_class);
@@ -704,18 +758,30 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
         !normalsBendLike(patchCurvature(cloud, indices, plane.direction),
                          shapeCurvature(fit.shape, points), p))
       continue;
-    const double z = medianDepth(cloud, indices);
-    if (fit.rms >
-        p.max_rms_factor * depthThreshold(z, p.planes.distance_factor, p.planes.min_distance))
-      continue;
     // Shape test: residuals well above a general quadric's are shape (e.g. an ellipsoid), not
     // noise. Only when the general quadric is a surface through the points: when the depth noise
     // is large against the patch's curvature (a far, narrow strip of a cylinder), its 10
     // coefficients fit the noise band instead, with two close sheets that split neighbouring
-    // points, and its RMS drops well below the noise that any true surface leaves.
+    // points, and its RMS drops well below the noise that any true surface leaves. The primitive
+    // is dropped; an ellipsoid found there is reported instead (before the primitive's RMS limit:
+    // a sphere on an elongated ellipsoid may well exceed it).
     const GeneralQuadricFit general = fitGeneralQuadric(points);
     if (general.ok && fit.rms > p.quadric_rms_ratio * general.rms &&
-        generalQuadricIsSurface(general, frame, indices, roiOf(indices, width)))
+        generalQuadricIsSurface(general, frame, indices, roiOf(indices, width))) {
+      if (p.detect_general) {
+        std::vector<int> general_indices;
+        const std::optional<ShapeRefiner::Result> ellipsoid =
+            detectEllipsoid(frame, general, unite(roi, grown(roiOf(indices, width),
+                                                              4 * p.cgal_stride, width, height)),
+                            p, refiner, &general_indices);
+        if (ellipsoid)
+          accept(ellipsoid->shape, general_indices, *ellipsoid);
+      }
+      continue;
+    }
+    const double z = medianDepth(cloud, indices);
+    if (fit.rms >
+        p.max_rms_factor * depthThreshold(z, p.planes.distance_factor, p.planes.min_distance))
       continue;
     accept(fit.shape, indices, fit);
   }
@@ -874,6 +940,11 @@ Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& 
   boundary.distance_factor = params_.planes.distance_factor;
   boundary.min_distance = params_.planes.min_distance;
   completeBoundaryLabels(cloud, boundary, result);
+  // The model error of the general detections, added once their support (which scales the
+  // least-squares part) is final.
+  for (QuadricDetection& d : result.detections)
+    if (d.shape.quadric_class == QuadricClass::kGeneral && d.covariance.rows() == 9)
+      d.covariance += ellipsoidModelCovariance(d.shape.general_quadric, params_.general_model_sigma);
   result.timings.boundary_ms = msSince(start);
   return result;
 }

@@ -39,6 +39,15 @@ std::pair<double, double> shapeErrors(const PrimitiveShape& d, const PrimitiveSh
   }
 }
 
+// The truth file's class name of a detection: a general quadric with the ellipsoid's signature is
+// an "ellipsoid" (the generator's name), the others their class's name.
+std::string truthClassName(const PrimitiveShape& shape) {
+  if (shape.quadric_class == QuadricClass::kGeneral &&
+      shape.general_quadric.signature() == Eigen::Vector4d(1, 1, 1, -1))
+    return "ellipsoid";
+  return toString(shape.quadric_class);
+}
+
 }  // namespace
 
 void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat& truth,
@@ -136,7 +145,7 @@ void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat
       }
     const auto it = truth_classes_.find(majority);
     if (majority == 0 || it == truth_classes_.end() ||
-        it->second != toString(d.shape.quadric_class)) {
+        it->second != truthClassName(d.shape)) {
       ++spurious_;
       if (majority != 0 && it != truth_classes_.end() && !scored(majority))
         ++spurious_unmodelled_;

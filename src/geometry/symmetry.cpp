@@ -1,6 +1,7 @@
 #include "quadric_slam/geometry/symmetry.h"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -26,7 +27,58 @@ Eigen::Matrix3d twistAbout(const Eigen::Matrix3d& R, const Eigen::Vector3d& a) {
   return twist.toRotationMatrix();
 }
 
+// |R| rounded when R is a signed permutation matrix (a relabelling of the axes), else I.
+Eigen::Matrix3d axisPermutationOf(const Eigen::Matrix3d& R) {
+  const Eigen::Matrix3d A = R.cwiseAbs();
+  const Eigen::Matrix3d rounded = A.array().round().matrix();
+  const bool permutation = (A - rounded).cwiseAbs().maxCoeff() < 1e-9 &&
+                           (rounded.rowwise().sum().array() == 1.0).all() &&
+                           (rounded.colwise().sum().array() == 1.0).all();
+  return permutation ? rounded : Eigen::Matrix3d::Identity();
+}
+
 }  // namespace
+
+std::vector<Eigen::Matrix3d> generalAxisRelabellings(const Eigen::Vector4d& signature) {
+  std::vector<Eigen::Matrix3d> out;
+  std::array<int, 3> order = {0, 1, 2};
+  do {
+    // Column j of P is +-e_order[j]: new axis j = old axis order[j] (same signature entry).
+    if (signature[order[0]] != signature[0] || signature[order[1]] != signature[1] ||
+        signature[order[2]] != signature[2])
+      continue;
+    for (int signs = 0; signs < 8; ++signs) {
+      Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
+      for (int j = 0; j < 3; ++j)
+        P(order[j], j) = (signs >> j) & 1 ? -1.0 : 1.0;
+      if (P.determinant() > 0)
+        out.push_back(P);
+    }
+  } while (std::next_permutation(order.begin(), order.end()));
+  return out;  // std::next_permutation starts at the identity order, signs 0 first
+}
+
+Eigen::Isometry3d symmetryAlignment(const QuadricModel& z, const Eigen::Isometry3d& T_z_h) {
+  if (z.quadricClass() != QuadricClass::kGeneral)
+    return symmetryAlignment(z.quadricClass(), T_z_h);
+  Eigen::Isometry3d G = Eigen::Isometry3d::Identity();
+  double best = -1e9;
+  for (const Eigen::Matrix3d& P : generalAxisRelabellings(z.signature())) {
+    const double trace = (P.transpose() * T_z_h.linear()).trace();
+    if (trace > best + 1e-12) {
+      best = trace;
+      G.linear() = P;
+    }
+  }
+  return G;
+}
+
+QuadricModel withSymmetry(const QuadricModel& z, const Eigen::Isometry3d& G) {
+  Eigen::Vector3d scale = z.scale();
+  if (z.quadricClass() == QuadricClass::kGeneral)
+    scale = axisPermutationOf(G.linear()).transpose() * z.scale();
+  return QuadricModel(z.quadricClass(), z.pose() * G, scale, z.signature());
+}
 
 Eigen::Isometry3d symmetryAlignment(QuadricClass quadric_class, const Eigen::Isometry3d& T_z_h) {
   const QuadricClassDefinition& def = classDefinition(quadric_class);
@@ -116,13 +168,14 @@ Eigen::MatrixXd minimalAdjoint(QuadricClass quadric_class, const Eigen::Isometry
   const Matrix9Xd& B = classDefinition(quadric_class).basis;
   Eigen::Matrix<double, 9, 9> ad = Eigen::Matrix<double, 9, 9>::Identity();
   ad.topLeftCorner<6, 6>() = adjointSE3(G);
+  if (quadric_class == QuadricClass::kGeneral)
+    ad.bottomRightCorner<3, 3>() = axisPermutationOf(G.linear());
   return basisPseudoInverse(quadric_class) * ad * B;
 }
 
 QuadricModel alignToReference(const QuadricModel& z, const QuadricModel& reference) {
   const Eigen::Isometry3d T_z_h = z.pose().inverse() * reference.pose();
-  const Eigen::Isometry3d G = symmetryAlignment(z.quadricClass(), T_z_h);
-  return QuadricModel(z.quadricClass(), z.pose() * G, z.scale(), z.signature());
+  return withSymmetry(z, symmetryAlignment(z, T_z_h));
 }
 
 Eigen::VectorXd surfaceMinus(const QuadricModel& a, const QuadricModel& b) {

@@ -21,6 +21,12 @@ MapFile mapFileFromLandmarks(const std::vector<QuadricLandmark>& landmarks,
     entry.T_map_quadric = quadric.pose();
     entry.scale = quadric.scale();
     entry.shape = shapeMap(quadric);
+    if (entry.quadric_class == "ellipsoid") {  // as the generator's truth: centre and semi-axes
+      const Eigen::Vector3d centre = quadric.pose().translation();
+      const Eigen::Vector3d radii = quadric.scale().cwiseInverse();
+      entry.shape["center"] = {centre.x(), centre.y(), centre.z()};
+      entry.shape["radii"] = {radii.x(), radii.y(), radii.z()};
+    }
     map.quadrics.push_back(entry);
   }
   return map;

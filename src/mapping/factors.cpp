@@ -58,10 +58,12 @@ bool QuadricObservationCost::Evaluate(double const* const* parameters, double* r
   const Eigen::Vector3d scale(parameters[1][7], parameters[1][8], parameters[1][9]);
   const Eigen::Isometry3d h = T_world_camera.inverse() * T_world_quadric;  // eq. 19
   const Eigen::Isometry3d D = T_quadric_camera_z_ * h;
-  const Eigen::Isometry3d G = symmetryAlignment(c, D);
+  // The member z G of the measurement's symmetry orbit closest to h; for a general quadric G may
+  // also relabel the axes, and the measured scales follow them (geometry/symmetry.h).
+  const Eigen::Isometry3d G = symmetryAlignment(z_, D);
   Vector9d r9;
-  r9.head<6>() = logSE3(G.inverse() * D);  // eq. 14: h [-] z G
-  r9.tail<3>() = scale - z_.scale();       // eq. 17
+  r9.head<6>() = logSE3(G.inverse() * D);              // eq. 14: h [-] z G
+  r9.tail<3>() = scale - withSymmetry(z_, G).scale();  // eq. 17
   const Eigen::MatrixXd LM = sqrt_information_ * minimalAdjoint(c, G);
   const int k = num_residuals();
   Eigen::Map<Eigen::VectorXd>(residuals, k) = LM * (basis_pinv_ * r9);

@@ -81,6 +81,8 @@ const std::vector<Entry>& table() {
       real("plane_rms_ratio", [](Params& p) -> double& { return p.plane_rms_ratio; }),
       real("cylinder_rms_ratio", [](Params& p) -> double& { return p.cylinder_rms_ratio; }),
       real("quadric_rms_ratio", [](Params& p) -> double& { return p.quadric_rms_ratio; }),
+      flag("detect_general", [](Params& p) -> bool& { return p.detect_general; }),
+      real("general_model_sigma", [](Params& p) -> double& { return p.general_model_sigma; }),
       real("max_rms_factor", [](Params& p) -> double& { return p.max_rms_factor; }),
       integer("refine_max_iterations", [](Params& p) -> int& { return p.refiner.max_iterations; }),
       integer("refine_max_points", [](Params& p) -> int& { return p.refiner.max_points; }),

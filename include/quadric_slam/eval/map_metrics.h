@@ -1,13 +1,15 @@
 // Map evaluation against a truth map (the generator's quadrics_gt.yaml), from the human-readable
 // `shape` keys of the map schema (io/map_yaml.h):
 //   plane normal + offset, sphere center + radius, cylinder point + axis + radius,
-//   cone apex + axis + half_angle.
+//   cone apex + axis + half_angle; an ellipsoid (the general class with the ellipsoid signature)
+//   from its pose and scale (semi-axes 1 / scale along the quadric axes).
 // The estimated map is first moved into the truth frame (T_truth_estimate, e.g. the ATE alignment
 // of the estimated trajectory onto the ground truth). Each estimate is assigned to the nearest true
 // primitive of its class whose every shape error is within that class's gate; per true primitive
 // the nearest assigned estimate is its match, further assigned estimates are duplicates, and a true
 // primitive without any is a miss. Estimates assigned to no truth are counted as unmatched.
-// Classes other than plane, sphere, cylinder and cone are not evaluated (counted as skipped).
+// Classes other than plane, sphere, cylinder, cone and ellipsoid (e.g. "general": a hyperboloid)
+// are not evaluated (counted as skipped).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -33,6 +35,9 @@ struct ShapeError {
 //   (truth point to estimated axis line),
 //             radius_m
 //   cone:     apex_m, axis_angle_deg (unsigned: the quadric is a double cone), half_angle_deg
+//   ellipsoid: center_m, semi_axis_1_m, semi_axis_2_m, semi_axis_3_m (the semi-axes of both
+//             sorted longest first: the frame's axis order is arbitrary), axis_angle_deg (unsigned,
+//             between the longest axes)
 // Throws std::runtime_error naming the quadric id and key when a shape key is missing or malformed,
 // std::invalid_argument when the classes differ or are not evaluated.
 std::vector<ShapeError> shapeErrors(const MapFileQuadric& truth, const MapFileQuadric& estimate);
@@ -40,7 +45,7 @@ std::vector<ShapeError> shapeErrors(const MapFileQuadric& truth, const MapFileQu
 // The quadric's shape keys moved by T_b_a (from frame a into frame b); pose moved too.
 MapFileQuadric transformQuadric(const MapFileQuadric& quadric, const Eigen::Isometry3d& T_b_a);
 
-// True for the classes map evaluation understands (plane, sphere, cylinder, cone).
+// True for the classes map evaluation understands (plane, sphere, cylinder, cone, ellipsoid).
 bool isEvaluatedClass(const std::string& quadric_class);
 
 struct TruthResult {
@@ -80,6 +85,9 @@ class MapEvaluator {
     double cone_apex_gate_m = 0.2;
     double cone_angle_gate_deg = 15.0;
     double cone_half_angle_gate_deg = 10.0;
+    double ellipsoid_center_gate_m = 0.2;
+    double ellipsoid_semi_axis_gate_m = 0.1;  // each of the three sorted semi-axes
+    double ellipsoid_angle_gate_deg = 30.0;   // the longest axes
 
     // Throws std::invalid_argument naming the bad field and its allowed range (0, inf).
     void validate() const;
@@ -103,7 +111,8 @@ class MapEvaluator {
 //
 // A true primitive's range: the median over the camera positions (truth frame) of the distance
 // from the camera to its surface (plane: perpendicular; sphere, cylinder: exact; cone: to the
-// nearest of its lines in the camera's axial plane). Keyed by truth id; classes not evaluated are
+// nearest of its lines in the camera's axial plane; ellipsoid: to its surface along the line to
+// its centre). Keyed by truth id; classes not evaluated are
 // left out. Throws std::invalid_argument when there are no camera positions.
 std::map<int, double> truthRanges(const MapFile& truth,
                                   const std::vector<Eigen::Vector3d>& camera_positions);

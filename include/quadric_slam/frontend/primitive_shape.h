@@ -1,6 +1,8 @@
 // A human-readable primitive (plane, sphere, cylinder, cone) in some frame, its geometric distance,
 // and its quadric in the geometry core (geometry/shapes.h quadricFromShape: the pose, scale and
-// Table II minimal perturbation all come from there).
+// Table II minimal perturbation all come from there). A general quadric (class general, e.g. an
+// ellipsoid) is carried as its core quadric (pi = (T, S, sigma), Section III) with a first-order
+// geometric distance.
 #pragma once
 
 #include <Eigen/Core>
@@ -24,6 +26,9 @@ struct PrimitiveShape {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();
   // sphere, cylinder: radius (m); cone: half angle (rad); plane: unused.
   double size = 0.0;
+  // general only: the quadric itself (point = its centre, direction = its first axis, size =
+  // 1 / its first scale entry, the first semi-axis of an ellipsoid, for display).
+  QuadricModel general_quadric;
 
   static PrimitiveShape plane(const Eigen::Vector3d& normal, double offset);
   static PrimitiveShape sphere(const Eigen::Vector3d& centre, double radius);
@@ -31,28 +36,32 @@ struct PrimitiveShape {
                                  double radius);
   static PrimitiveShape cone(const Eigen::Vector3d& apex, const Eigen::Vector3d& axis,
                              double half_angle);
+  // Throws std::invalid_argument when the quadric is not of class general.
+  static PrimitiveShape general(const QuadricModel& quadric);
 
   // Plane offset n.p (points p with n.p = offset).
   double planeOffset() const { return direction.dot(point); }
 
   // The `shape` vector of msg/QuadricSurface.msg: plane [n, offset], sphere [c, r], cylinder
-  // [p, d, r], cone [apex, d, half_angle].
+  // [p, d, r], cone [apex, d, half_angle], general [] (pose and scale say it all).
   std::vector<double> shapeVector() const;
   // The `shape` block of the map schema (io/map_yaml.h keys): plane normal, offset; sphere
-  // center, radius; cylinder point, axis, radius; cone apex, axis, half_angle.
+  // center, radius; cylinder point, axis, radius; cone apex, axis, half_angle; general center,
+  // radii (1 / scale: an ellipsoid's semi-axes).
   std::map<std::string, std::vector<double>> schemaShape() const;
 
   // The core quadric of this shape (geometry/shapes.h quadricFromShape: plane normal = quadric x
   // with origin offset * normal; sphere origin = centre; cylinder origin = the axis point, axis =
-  // quadric z; cone origin = apex, axis = quadric z). Throws std::invalid_argument for class
-  // general or an invalid size.
+  // quadric z; cone origin = apex, axis = quadric z; general: general_quadric). Throws
+  // std::invalid_argument for an invalid size.
   QuadricModel quadric() const;
   // Inverse of quadric() (planeShape, sphereShape, ... of geometry/shapes.h).
   static PrimitiveShape fromQuadric(const QuadricModel& quadric);
 
   // Signed geometric distance (m) of a point (same frame) to the surface: plane n.p - offset,
   // sphere |p - c| - r, cylinder (distance to axis) - r, cone rho cos(a) - z sin(a) in the cone
-  // frame (exact near the nappe).
+  // frame (exact near the nappe); general f / |grad f| (geometry/surface_distance.h: first order,
+  // signed like f, finite: |grad f| is floored).
   // Planes (most calls: per pixel in the segmenter's upsampling and boundary passes) inline.
   double distance(const Eigen::Vector3d& p) const {
     return quadric_class == QuadricClass::kPlane ? direction.dot(p - point) : curvedDistance(p);
@@ -77,7 +86,8 @@ struct PrimitiveShape {
 const std::vector<int>& minimalIndices(QuadricClass quadric_class);
 
 // pi [+] delta (eqs. 9-17) through the core: fromQuadric(shape.quadric().plusMinimal(delta)),
-// delta with minimalDimension(class) entries ordered as minimalIndices(). Throws
+// delta with minimalDimension(class) entries ordered as minimalIndices() (general: the nine
+// [rho; phi; alpha, beta, gamma] of Table II's general row). Throws
 // std::invalid_argument when the step leaves the class (a scale alpha driven to <= 0).
 PrimitiveShape perturb(const PrimitiveShape& shape, const Eigen::VectorXd& delta);
 

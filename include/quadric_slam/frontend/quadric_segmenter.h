@@ -1,5 +1,6 @@
 // Quadric segmentation of one depth frame: organized cloud with normals -> planes, spheres,
-// cylinders and cones (the paper's front-end, Section IV), each with its least-squares fit,
+// cylinders, cones and ellipsoids (class general) (the paper's front-end, Section IV), each with
+// its least-squares fit,
 // covariance, support and image extent, plus a label image.
 //
 // Pipeline (all in the camera frame):
@@ -14,7 +15,9 @@
 //     near the surface with agreeing normals, the largest image-grid connected component (with
 //     the large ones on the surface's other face: an open bin's inner wall), minimum support,
 //     refinement again (shape_refiner.h); near-flat (plane RMS close AND normals not bending
-//     like the shape) and shape (RMS against a general quadric that is a surface) tests.
+//     like the shape) and shape (RMS against a general quadric that is a surface) tests; where
+//     the shape test finds an ellipsoid, the ellipsoid is re-assigned, refined and reported
+//     instead (class general, detect_general).
 #pragma once
 
 #include <pcl/point_cloud.h>
@@ -37,8 +40,9 @@ struct QuadricDetection {
   PrimitiveShape shape;
   // Covariance of the fit in the class's minimal coordinates (Table II, geometry/quadric_classes.h
   // basis: plane (rho1, phi2, phi3); sphere (rho1..3, s); cylinder (rho1, rho2, phi1, phi2, s);
-  // cone (rho1..3, phi1, phi2, s)), a right (body-frame) perturbation of shape.quadric() with s
-  // the radial entry of S: sigma^2 (J^T J)^-1 of the least squares.
+  // cone (rho1..3, phi1, phi2, s); general (rho1..3, phi1..3, alpha, beta, gamma)), a right
+  // (body-frame) perturbation of shape.quadric() with s the radial entry of S: sigma^2 (J^T J)^-1
+  // of the least squares.
   Eigen::MatrixXd covariance;
   // Supporting points (cloud grid): the labelled pixels, boundary points without normals included
   // (boundary_labels.h); the fit, its RMS and covariance use the points with normals.
@@ -129,6 +133,16 @@ class QuadricSegmenter {
     // with two close sheets that split neighbouring points (under 3/4 of the grid neighbours on
     // one sheet), which undercuts any true surface's RMS. >= 1; default 1.3.
     double quadric_rms_ratio = 1.3;
+    // Report what the shape test finds as a detection of class general when the general quadric
+    // is an ellipsoid with semi-axes within [min_sphere_radius, max_sphere_radius]
+    // (ellipsoid_candidate.h): re-assigned, refined on its 9 minimal parameters (shape_refiner.h)
+    // and held to max_rms_factor like the other curved shapes. Default true.
+    bool detect_general = true;
+    // Model error of a general detection (m, [0, 0.1]): added to its least-squares covariance as
+    // ellipsoid_candidate.h's ellipsoidModelCovariance (translation, rotation and scale entries
+    // scaled from this 1-sigma error of the surface) so that the mapper's gates and weights see
+    // the view-to-view scatter of one-sided fits. Default 0.01.
+    double general_model_sigma = 0.01;
     // Largest fit RMS of a curved segment, relative to its distance threshold at the median
     // depth, (0, 10].
     double max_rms_factor = 0.6;

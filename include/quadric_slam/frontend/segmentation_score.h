@@ -22,7 +22,8 @@ class SegmentationScore {
   // non-zero where the depth is valid (labels of pixels without depth are not counted). A scored
   // surface is detected when a detection of its class has >= 50% of its pixels on the surface and
   // covers >= 30% of the surface's pixels. A detection is spurious when the majority of its pixels
-  // lies on no surface or on a surface of another class.
+  // lies on no surface or on a surface of another class (a general detection with the ellipsoid's
+  // signature is of class "ellipsoid").
   void addFrame(const Segmentation& segmentation, const cv::Mat& truth, const cv::Mat& valid);
 
   // The same, and the parameter errors of the detections counted as found, against the true

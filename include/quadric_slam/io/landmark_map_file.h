@@ -10,7 +10,9 @@
 namespace quadric_slam {
 
 // One entry per landmark: id, class (a general quadric with the ellipsoid signature is written as
-// "ellipsoid"), observation count, T_map_quadric, scale and the human-readable shape of its class.
+// "ellipsoid", with the shape keys center and radii (its semi-axes along quadric x, y, z) as in
+// the generator's truth), observation count, T_map_quadric, scale and the human-readable shape of
+// its class.
 MapFile mapFileFromLandmarks(const std::vector<QuadricLandmark>& landmarks,
                              const std::string& frame_id);
 

@@ -17,7 +17,8 @@ struct MapFileQuadric {
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();  // diagonal of S (1/m)
   // Human-readable shape, keyed as in the schema: plane normal (3) + offset (1); sphere center (3)
   // + radius (1); cylinder point (3) + axis (3) + radius (1); cone apex (3) + axis (3) +
-  // half_angle (1, rad). Scalars are vectors of length 1.
+  // half_angle (1, rad); ellipsoid center (3) + radii (3, the semi-axes along quadric x, y, z).
+  // Scalars are vectors of length 1.
   std::map<std::string, std::vector<double>> shape;
 };
 

@@ -24,9 +24,10 @@ Eigen::MatrixXd sqrtInformation(const Eigen::MatrixXd& covariance, const char* w
 // the landmark, covariance Sigma (k x k) in the class's minimal space (Table II), expressed in z's
 // own frame: z = h [+] nu, nu ~ N(0, Sigma) (eq. 18).
 //
-// Derivation. Prediction h = T_WC^-1 T_WQ (eq. 19). With D = z^-1 h and G = symmetryAlignment(D)
+// Derivation. Prediction h = T_WC^-1 T_WQ (eq. 19). With D = z^-1 h and G = symmetryAlignment(z, D)
 // (geometry/symmetry.h: z G is the member of z's symmetry orbit closest to h),
-//   e = log(G^-1 z^-1 h)^vee  (eq. 14: h [-] zG),  x = B^+ [e; s_h - s_z]  (eq. 17, Table II)
+//   e = log(G^-1 z^-1 h)^vee  (eq. 14: h [-] zG),  x = B^+ [e; s_h - s_zG]  (eq. 17, Table II)
+// (s_zG = s_z except for a general quadric whose G relabels the axes: s_zG = |R_G|^T s_z)
 // and the dropped (symmetry) components of e are zero, so x depends on the surfaces only. The noise
 // of zG is Ad(G^-1) nu, so x ~ N(0, A Sigma A^T) with A = minimalAdjoint(G^-1); whitening with
 // L A^-1 = L M, M = minimalAdjoint(G), L^T L = Sigma^-1, gives the residual (eq. 22)

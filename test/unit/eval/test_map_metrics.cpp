@@ -75,7 +75,7 @@ TEST(MapMetrics, HandMadeMapsWithKnownErrors) {
       quadric(3, "sphere", {{"center", {1, 1, 0.5}}, {"radius", {0.2}}}),
       quadric(4, "cylinder", {{"point", {0, 1, 0.5}}, {"axis", {0, 0, 1}}, {"radius", {0.1}}}),
       quadric(5, "cone", {{"apex", {2, 0, 1}}, {"axis", {0, 0, -1}}, {"half_angle", {0.5}}}),
-      quadric(6, "ellipsoid", {}),
+      quadric(6, "general", {}),  // a hyperboloid, say: not evaluated
   };
 
   // Estimates built in the truth frame with known errors, then expressed in the estimate frame.
@@ -105,7 +105,7 @@ TEST(MapMetrics, HandMadeMapsWithKnownErrors) {
           {{"apex", {2, 0.05, 1}}, {"axis", vec(cone_axis)}, {"half_angle", {0.5 + 2.0 * kDeg}}}),
       quadric(16, "sphere", {{"center", {11, 1, 0.5}}, {"radius", {0.2}}}),  // nothing there
       quadric(17, "plane", {{"normal", vec(wall_30)}, {"offset", {2.0}}}),   // 30 deg off the wall
-      quadric(18, "ellipsoid", {}),
+      quadric(18, "general", {}),
   };
   MapFile estimate;
   for (const auto& q : in_truth_frame.quadrics) {
