@@ -9,12 +9,13 @@
 #include <cmath>
 #include <random>
 
+#include "primitive_desk_scene.h"
 #include "quadric_slam/frontend/detection_measurement.h"
 #include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/sim/primitive_scene_renderer.h"
 #include "quadric_slam/frontend/shape_refiner.h"
 #include "quadric_slam/geometry/symmetry.h"
 #include "quadric_slam/io/frame_source.h"
+#include "quadric_slam/sim/primitive_scene_renderer.h"
 
 namespace qs = quadric_slam;
 using qs::PrimitiveShape;
@@ -30,24 +31,6 @@ qs::CameraIntrinsics kinect() {
   k.width = 640;
   k.height = 480;
   return k;
-}
-
-// Floor, wall, sphere, upright cylinder (axis point at its base, far from the visible middle) and
-// cone, as in test_quadric_segmenter.cpp.
-std::vector<qs::ScenePrimitive> deskScene() {
-  std::vector<qs::ScenePrimitive> scene(5);
-  scene[0].shape = PrimitiveShape::plane(Eigen::Vector3d(0, -1, 0), -0.8);
-  scene[1].shape = PrimitiveShape::plane(Eigen::Vector3d(0, 0, -1), -2.5);
-  scene[2].shape = PrimitiveShape::sphere(Eigen::Vector3d(-0.45, 0.25, 1.6), 0.15);
-  scene[3].shape =
-      PrimitiveShape::cylinder(Eigen::Vector3d(0.05, 0.8, 1.8), Eigen::Vector3d(0, -1, 0), 0.09);
-  scene[3].axis_min = 0.0;
-  scene[3].axis_max = 0.55;
-  scene[4].shape =
-      PrimitiveShape::cone(Eigen::Vector3d(0.55, 0.3, 1.5), Eigen::Vector3d(0, 1, 0), 0.4);
-  scene[4].axis_min = 0.1;
-  scene[4].axis_max = 0.5;
-  return scene;
 }
 
 pcl::PointCloud<pcl::PointNormal> cloudWithNormals(const cv::Mat& depth) {
@@ -67,7 +50,8 @@ double quadricValue(const qs::QuadricModel& q, const Eigen::Vector3d& p) {
 }  // namespace
 
 TEST(DetectionMeasurement, SegmenterDetectionsBecomeCoreQuadricsWithTheirExtentBoxes) {
-  const qs::PrimitiveRendering frame = qs::renderPrimitives(deskScene(), kinect(), qs::RenderParams());
+  const qs::PrimitiveRendering frame =
+      qs::renderPrimitives(qs::test::primitiveDeskScene(), kinect(), qs::RenderParams());
   const pcl::PointCloud<pcl::PointNormal> cloud = cloudWithNormals(frame.depth);
   const qs::Segmentation seg = qs::QuadricSegmenter(qs::QuadricSegmenter::Params()).segment(cloud);
   ASSERT_GE(seg.detections.size(), 5u);

@@ -2,8 +2,9 @@
 // (T, S, sigma) (frontend/central_quadric.h) round-trip random ellipsoids and hyperboloids and
 // refuse non-central surfaces; the segmenter reports an ellipsoid rendered on its own by the
 // generator's ray caster (Kinect noise) as ONE detection of class general with its semi-axes within
-// 1 cm and a 9x9 covariance, and reports no general quadric on the planes, sphere, cylinder and cone
-// of the segmenter's rendered desk scene (test_quadric_segmenter.cpp), where those are still found.
+// 1 cm and a 9x9 covariance, and reports no general quadric on the planes, sphere, cylinder and
+// cone of the segmenter's rendered desk scene (test_quadric_segmenter.cpp), where those are still
+// found.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -15,9 +16,10 @@
 #include <utility>
 
 #include "../test_support.h"
+#include "primitive_desk_scene.h"
 #include "quadric_slam/frontend/central_quadric.h"
-#include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/ellipsoid_candidate.h"
+#include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/general_quadric_fit.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
@@ -36,8 +38,9 @@ double lineAngle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }
 
 // Points of the ellipsoid T (x/a)^2 + (y/b)^2 + (z/c)^2 = 1 over all directions.
-std::vector<Eigen::Vector3d> ellipsoidPoints(const Eigen::Isometry3d& T, const Eigen::Vector3d& radii,
-                                             std::mt19937& rng, int n) {
+std::vector<Eigen::Vector3d> ellipsoidPoints(const Eigen::Isometry3d& T,
+                                             const Eigen::Vector3d& radii, std::mt19937& rng,
+                                             int n) {
   std::normal_distribution<double> gauss(0.0, 1.0);
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < n; ++i) {
@@ -89,7 +92,8 @@ TEST(CentralQuadric, HyperboloidOfOneSheetKeepsItsSignature) {
     const QuadricModel q = centralQuadricFromFit(fitGeneralQuadric(points, 600, 8));
     EXPECT_EQ(q.signature(), Eigen::Vector4d(1, 1, -1, -1));
     // Within the +1 group the larger semi-axis comes first; the -1 axis keeps its place.
-    EXPECT_LT((q.scale() - Eigen::Vector3d(1 / 0.3, 1 / 0.2, 1 / 0.25)).cwiseAbs().maxCoeff(), 1e-5);
+    EXPECT_LT((q.scale() - Eigen::Vector3d(1 / 0.3, 1 / 0.2, 1 / 0.25)).cwiseAbs().maxCoeff(),
+              1e-5);
     EXPECT_LT(lineAngle(q.pose().linear().col(2), T.linear().col(2)), 1e-5);
     EXPECT_FALSE(ellipsoidCandidate(fitGeneralQuadric(points, 600, 8), 0.03, 0.6).has_value());
   }
@@ -105,8 +109,7 @@ TEST(CentralQuadric, NonCentralSurfacesAreRefused) {
     paraboloid.emplace_back(x, y, 2 * x * x + 3 * y * y);
   }
   EXPECT_THROW(centralQuadricFromFit(fitGeneralQuadric(cylinder, 600, 8)), std::invalid_argument);
-  EXPECT_THROW(centralQuadricFromFit(fitGeneralQuadric(paraboloid, 600, 8)),
-               std::invalid_argument);
+  EXPECT_THROW(centralQuadricFromFit(fitGeneralQuadric(paraboloid, 600, 8)), std::invalid_argument);
   EXPECT_THROW(centralQuadricFromFit(GeneralQuadricFit()), std::invalid_argument);  // not ok
 }
 
@@ -131,10 +134,9 @@ pcl::PointCloud<pcl::PointNormal> cloudOf(const cv::Mat& depth, const CameraIntr
 }
 
 int countOfClass(const Segmentation& s, QuadricClass c) {
-  return static_cast<int>(std::count_if(s.detections.begin(), s.detections.end(),
-                                        [&](const QuadricDetection& d) {
-                                          return d.shape.quadric_class == c;
-                                        }));
+  return static_cast<int>(
+      std::count_if(s.detections.begin(), s.detections.end(),
+                    [&](const QuadricDetection& d) { return d.shape.quadric_class == c; }));
 }
 
 // The desk scene's cushion (semi-axes 0.13, 0.08, 0.07 m, turned 0.5 rad about z), alone, seen from
@@ -168,14 +170,16 @@ TEST(GeneralDetection, EllipsoidRenderedAloneIsOneGeneralDetection) {
       // Semi-axes longest first, like the truth's.
       const Eigen::Vector3d semi_axes = q_world.scale().cwiseInverse();
       const Eigen::Vector3d error = (semi_axes - radii).cwiseAbs();
-      std::printf("view %d semi-axes %.4f %.4f %.4f (errors %.4f %.4f %.4f) centre error %.4f "
-                  "points %d rms %.4f\n",
-                  view, semi_axes.x(), semi_axes.y(), semi_axes.z(), error.x(), error.y(),
-                  error.z(), q_world.pose().translation().norm(), d.num_points, d.fit_rms);
+      std::printf(
+          "view %d semi-axes %.4f %.4f %.4f (errors %.4f %.4f %.4f) centre error %.4f "
+          "points %d rms %.4f\n",
+          view, semi_axes.x(), semi_axes.y(), semi_axes.z(), error.x(), error.y(), error.z(),
+          q_world.pose().translation().norm(), d.num_points, d.fit_rms);
       EXPECT_LT(error.maxCoeff(), 0.01) << "view " << view;
       EXPECT_LT(q_world.pose().translation().norm(), 0.01) << "view " << view;
-      EXPECT_LT(lineAngle(q_world.pose().linear().col(0), cushion.T_world_primitive.linear().col(0)),
-                0.15)
+      EXPECT_LT(
+          lineAngle(q_world.pose().linear().col(0), cushion.T_world_primitive.linear().col(0)),
+          0.15)
           << "view " << view;
       // Most of the visible ellipsoid is the segment.
       const int visible = cv::countNonZero(frame.labels);
@@ -185,8 +189,9 @@ TEST(GeneralDetection, EllipsoidRenderedAloneIsOneGeneralDetection) {
       ASSERT_EQ(d.covariance.cols(), 9);
       EXPECT_LT((d.covariance - d.covariance.transpose()).cwiseAbs().maxCoeff(),
                 1e-9 * d.covariance.cwiseAbs().maxCoeff());
-      EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(d.covariance).eigenvalues().minCoeff(),
-                0.0);
+      EXPECT_GT(
+          Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(d.covariance).eigenvalues().minCoeff(),
+          0.0);
       // ... holding the model error of a one-sided view (general_model_sigma, 1 cm by default).
       const Eigen::MatrixXd model = ellipsoidModelCovariance(d.shape.general_quadric, 0.01);
       for (int i = 0; i < 9; ++i)
@@ -245,20 +250,7 @@ TEST(GeneralDetection, NoGeneralQuadricOnPlanesSpheresCylindersAndCones) {
       {Eigen::Isometry3d::Identity(), 7}, {tilted, 19}, {tilted, 23}};
   for (const auto& [T, seed] : views) {
     const std::string view = "seed " + std::to_string(seed);
-    std::vector<ScenePrimitive> scene(5);
-    scene[0].shape = PrimitiveShape::plane(Eigen::Vector3d(0, -1, 0), -0.8);
-    scene[1].shape = PrimitiveShape::plane(Eigen::Vector3d(0, 0, -1), -2.5);
-    scene[2].shape = PrimitiveShape::sphere(Eigen::Vector3d(-0.45, 0.25, 1.6), 0.15);
-    scene[3].shape =
-        PrimitiveShape::cylinder(Eigen::Vector3d(0.05, 0.8, 1.8), Eigen::Vector3d(0, -1, 0), 0.09);
-    scene[3].axis_min = 0.0;
-    scene[3].axis_max = 0.55;
-    scene[4].shape =
-        PrimitiveShape::cone(Eigen::Vector3d(0.55, 0.3, 1.5), Eigen::Vector3d(0, 1, 0), 0.4);
-    scene[4].axis_min = 0.1;
-    scene[4].axis_max = 0.5;
-    for (auto& p : scene)
-      p.shape = p.shape.transformed(T);
+    const std::vector<ScenePrimitive> scene = test::primitiveDeskScene(T);
     RenderParams render;
     render.seed = seed;
     const PrimitiveRendering r = renderPrimitives(scene, k, render);

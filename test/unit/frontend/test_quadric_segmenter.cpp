@@ -12,10 +12,11 @@
 #include <limits>
 #include <map>
 
+#include "primitive_desk_scene.h"
 #include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/sim/primitive_scene_renderer.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/io/frame_source.h"
+#include "quadric_slam/sim/primitive_scene_renderer.h"
 
 namespace qs = quadric_slam;
 using qs::PrimitiveShape;
@@ -33,26 +34,6 @@ qs::CameraIntrinsics kinect() {
   k.width = 640;
   k.height = 480;
   return k;
-}
-
-// Floor 0.8 m below the camera, a wall at 2.5 m, and a sphere, an upright cylinder and an
-// upside-down cone (apex up) standing on the floor at 1.5-1.8 m; T_camera_scene tilts the scene.
-std::vector<qs::ScenePrimitive> deskScene(const Eigen::Isometry3d& T_camera_scene) {
-  std::vector<qs::ScenePrimitive> scene(5);
-  scene[0].shape = PrimitiveShape::plane(Eigen::Vector3d(0, -1, 0), -0.8);
-  scene[1].shape = PrimitiveShape::plane(Eigen::Vector3d(0, 0, -1), -2.5);
-  scene[2].shape = PrimitiveShape::sphere(Eigen::Vector3d(-0.45, 0.25, 1.6), 0.15);
-  scene[3].shape =
-      PrimitiveShape::cylinder(Eigen::Vector3d(0.05, 0.8, 1.8), Eigen::Vector3d(0, -1, 0), 0.09);
-  scene[3].axis_min = 0.0;
-  scene[3].axis_max = 0.55;
-  scene[4].shape =
-      PrimitiveShape::cone(Eigen::Vector3d(0.55, 0.3, 1.5), Eigen::Vector3d(0, 1, 0), 0.4);
-  scene[4].axis_min = 0.1;
-  scene[4].axis_max = 0.5;
-  for (auto& p : scene)
-    p.shape = p.shape.transformed(T_camera_scene);
-  return scene;
 }
 
 pcl::PointCloud<pcl::PointNormal> cloudWithNormals(const cv::Mat& depth) {
@@ -84,7 +65,7 @@ double iou(const cv::Mat& labels, std::uint16_t label, const cv::Mat& truth, std
 }
 
 void checkScene(const Eigen::Isometry3d& T_camera_scene, unsigned seed) {
-  const std::vector<qs::ScenePrimitive> scene = deskScene(T_camera_scene);
+  const std::vector<qs::ScenePrimitive> scene = qs::test::primitiveDeskScene(T_camera_scene);
   qs::RenderParams render;
   render.seed = seed;
   const qs::PrimitiveRendering frame = qs::renderPrimitives(scene, kinect(), render);
@@ -178,8 +159,8 @@ TEST(QuadricSegmenter, FindsThemInATiltedView) {
 }
 
 TEST(QuadricSegmenter, LabelsAreConsistentWithDetections) {
-  const qs::PrimitiveRendering frame =
-      qs::renderPrimitives(deskScene(Eigen::Isometry3d::Identity()), kinect(), qs::RenderParams());
+  const qs::PrimitiveRendering frame = qs::renderPrimitives(
+      qs::test::primitiveDeskScene(Eigen::Isometry3d::Identity()), kinect(), qs::RenderParams());
   const qs::Segmentation result =
       qs::QuadricSegmenter(qs::QuadricSegmenter::Params()).segment(cloudWithNormals(frame.depth));
   ASSERT_FALSE(result.detections.empty());

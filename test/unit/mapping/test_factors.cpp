@@ -8,6 +8,7 @@
 #include <random>
 
 #include "../test_support.h"
+#include "cost_jacobian_checks.h"
 #include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/geometry/surface_distance.h"
 #include "quadric_slam/geometry/symmetry.h"
@@ -16,7 +17,6 @@
 namespace quadric_slam {
 namespace {
 
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using PoseBlock = std::array<double, kPoseParameterSize>;
 using QuadricBlock = std::array<double, kQuadricParameterSize>;
 
@@ -33,7 +33,7 @@ Eigen::VectorXd randomVectorX(std::mt19937& rng, int n, double sigma) {
 // orbit) so that the cost must not depend on the frame the front-end happened to choose. The
 // covariance in that frame is returned in *covariance (M sigma^2 M^T, M = minimalAdjoint(G^-1)).
 QuadricModel observe(const QuadricModel& truth, const Eigen::Isometry3d& T_WC, double sigma,
-                std::mt19937& rng, Eigen::MatrixXd* covariance = nullptr) {
+                     std::mt19937& rng, Eigen::MatrixXd* covariance = nullptr) {
   const QuadricClass c = truth.quadricClass();
   const int k = minimalDimension(c);
   const QuadricModel h = predictMeasurement(T_WC, truth);
@@ -45,46 +45,6 @@ QuadricModel observe(const QuadricModel& truth, const Eigen::Isometry3d& T_WC, d
     *covariance = 0.5 * (*covariance + covariance->transpose()).eval();
   }
   return QuadricModel(c, noisy.pose() * G, noisy.scale(), noisy.signature());
-}
-
-Eigen::VectorXd evaluate(const ceres::CostFunction& cost,
-                         const std::vector<const double*>& blocks) {
-  Eigen::VectorXd r(cost.num_residuals());
-  cost.Evaluate(blocks.data(), r.data(), nullptr);
-  return r;
-}
-
-// Analytic (ambient Jacobian x PlusJacobian) against central differences through Plus, per block.
-void expectCostJacobians(const ceres::CostFunction& cost, const std::vector<double*>& blocks,
-                         const std::vector<const ceres::Manifold*>& manifolds) {
-  const int m = cost.num_residuals();
-  std::vector<RowMajor> jac;
-  std::vector<double*> jac_ptrs;
-  for (size_t b = 0; b < blocks.size(); ++b)
-    jac.emplace_back(m, cost.parameter_block_sizes()[b]);
-  for (auto& j : jac)
-    jac_ptrs.push_back(j.data());
-  Eigen::VectorXd r(m);
-  ASSERT_TRUE(cost.Evaluate(blocks.data(), r.data(), jac_ptrs.data()));
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    const ceres::Manifold& man = *manifolds[b];
-    const int n = man.AmbientSize(), k = man.TangentSize();
-    RowMajor plus_j(n, k);
-    man.PlusJacobian(blocks[b], plus_j.data());
-    const Eigen::MatrixXd analytic = jac[b] * plus_j;
-    const Eigen::MatrixXd numeric = test::numericJacobian(
-        [&](const Eigen::VectorXd& d) -> Eigen::VectorXd {
-          std::vector<double> moved(n);
-          man.Plus(blocks[b], d.data(), moved.data());
-          std::vector<const double*> args(blocks.begin(), blocks.end());
-          args[b] = moved.data();
-          return evaluate(cost, args);
-        },
-        k);
-    EXPECT_LT(test::relativeError(analytic, numeric), 1e-6) << "block " << b << "\nanalytic\n"
-                                                            << analytic << "\nnumeric\n"
-                                                            << numeric;
-  }
 }
 
 void expectObservationJacobians(QuadricClass c, int seed) {
@@ -105,7 +65,8 @@ void expectObservationJacobians(QuadricClass c, int seed) {
     QuadricBlock quadric;
     poseToParameters(plus(T_WC, randomVectorX(rng, 6, 0.1)), pose.data());
     quadricToParameters(state, quadric.data());
-    expectCostJacobians(*cost, {pose.data(), quadric.data()}, {&pose_manifold, &quadric_manifold});
+    test::expectCostJacobians(*cost, {pose.data(), quadric.data()},
+                              {&pose_manifold, &quadric_manifold});
   }
 }
 
@@ -135,7 +96,7 @@ TEST(RelativePoseFactor, JacobianMatchesNumeric) {
     PoseBlock a, b;
     poseToParameters(test::randomPose(rng), a.data());
     poseToParameters(test::randomPose(rng), b.data());
-    expectCostJacobians(*cost, {a.data(), b.data()}, {&m, &m});
+    test::expectCostJacobians(*cost, {a.data(), b.data()}, {&m, &m});
   }
 }
 
@@ -147,7 +108,7 @@ TEST(PosePriorFactor, JacobianMatchesNumeric) {
         PosePriorCost::Create(test::randomPose(rng), 0.01 * Matrix6d::Identity()));
     PoseBlock a;
     poseToParameters(test::randomPose(rng), a.data());
-    expectCostJacobians(*cost, {a.data()}, {&m});
+    test::expectCostJacobians(*cost, {a.data()}, {&m});
   }
 }
 
@@ -157,11 +118,11 @@ TEST(PosePriorFactor, ZeroAtPriorAndWhitened) {
   std::unique_ptr<ceres::CostFunction> cost(PosePriorCost::Create(T, 0.04 * Matrix6d::Identity()));
   PoseBlock a;
   poseToParameters(T, a.data());
-  EXPECT_LT(evaluate(*cost, {a.data()}).norm(), 1e-12);
+  EXPECT_LT(test::evaluate(*cost, {a.data()}).norm(), 1e-12);
   Vector6d d = Vector6d::Zero();
   d[0] = 0.1;  // 0.1 m with sigma 0.2 m: whitened residual 0.5
   poseToParameters(plus(T, d), a.data());
-  EXPECT_NEAR(evaluate(*cost, {a.data()})[0], 0.5, 1e-12);
+  EXPECT_NEAR(test::evaluate(*cost, {a.data()})[0], 0.5, 1e-12);
 }
 
 TEST(QuadricObservationCost, RejectsBadCovariance) {
@@ -190,9 +151,10 @@ void expectResidualInvariant(QuadricClass c, int seed) {
     Eigen::MatrixXd cov = Eigen::MatrixXd::Random(k, k);
     cov = cov * cov.transpose() * 0.01 + 0.001 * Eigen::MatrixXd::Identity(k, k);
     const QuadricModel h = predictMeasurement(T_WC, truth);
-    const QuadricModel h_other(c, h.pose() * test::randomSymmetry(c, rng), h.scale(), h.signature());
+    const QuadricModel h_other(c, h.pose() * test::randomSymmetry(c, rng), h.scale(),
+                               h.signature());
     std::unique_ptr<ceres::CostFunction> exact(QuadricObservationCost::Create(h_other, cov));
-    EXPECT_LT(evaluate(*exact, {pose.data(), quadric.data()}).norm(), 1e-9)
+    EXPECT_LT(test::evaluate(*exact, {pose.data(), quadric.data()}).norm(), 1e-9)
         << toString(c) << " trial " << trial;
     const QuadricModel z = h.plusMinimal(randomVectorX(rng, k, 0.1));
     const Eigen::Isometry3d G0 = test::randomSymmetry(c, rng);
@@ -202,8 +164,8 @@ void expectResidualInvariant(QuadricClass c, int seed) {
     std::unique_ptr<ceres::CostFunction> cost_a(QuadricObservationCost::Create(z, cov));
     std::unique_ptr<ceres::CostFunction> cost_b(
         QuadricObservationCost::Create(z_other, 0.5 * (cov_other + cov_other.transpose())));
-    const Eigen::VectorXd ra = evaluate(*cost_a, {pose.data(), quadric.data()});
-    const Eigen::VectorXd rb = evaluate(*cost_b, {pose.data(), quadric.data()});
+    const Eigen::VectorXd ra = test::evaluate(*cost_a, {pose.data(), quadric.data()});
+    const Eigen::VectorXd rb = test::evaluate(*cost_b, {pose.data(), quadric.data()});
     EXPECT_GT(ra.norm(), 1e-2);
     // The whitened residual vectors may differ by an orthogonal map (L is a square root of the
     // information); the cost and its Mahalanobis norm must not.
@@ -317,7 +279,7 @@ struct PointOnEllipsoidResidual {
   explicit PointOnEllipsoidResidual(const Eigen::Vector3d& p) : p_(p) {}
   bool operator()(const double* q, double* residual) const {
     const QuadricModel quadric(QuadricClass::kGeneral, poseFromParameters(q),
-                          Eigen::Vector3d(q[7], q[8], q[9]), Eigen::Vector4d(1, 1, 1, -1));
+                               Eigen::Vector3d(q[7], q[8], q[9]), Eigen::Vector4d(1, 1, 1, -1));
     residual[0] = algebraicDistance(quadric, p_);
     return true;
   }
@@ -367,24 +329,27 @@ TEST(JointProblem, TenPosesFourQuadricsConvergeWithDogleg) {
   }
   const std::vector<QuadricModel> truth_quadrics = {
       QuadricModel(QuadricClass::kPlane, makeIsometry(Eigen::Matrix3d::Identity(), {0, 4, 0}),
-              Eigen::Vector3d::Ones()),  // wall x = 0 ... rotated below
-      QuadricModel(QuadricClass::kSphere, makeIsometry(Eigen::Matrix3d::Identity(), {1.0, 3.0, 0.8}),
-              Eigen::Vector3d::Constant(1 / 0.3)),
-      QuadricModel(QuadricClass::kCylinder, makeIsometry(Eigen::Matrix3d::Identity(), {2.0, 3.5, 0.0}),
-              Eigen::Vector3d(1 / 0.2, 1 / 0.2, 1)),
-      QuadricModel(QuadricClass::kCone,
-              makeIsometry(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix(),
-                           {3.0, 3.0, 1.5}),
-              Eigen::Vector3d(1 / std::tan(0.4), 1 / std::tan(0.4), 1))};
+                   Eigen::Vector3d::Ones()),  // wall x = 0 ... rotated below
+      QuadricModel(QuadricClass::kSphere,
+                   makeIsometry(Eigen::Matrix3d::Identity(), {1.0, 3.0, 0.8}),
+                   Eigen::Vector3d::Constant(1 / 0.3)),
+      QuadricModel(QuadricClass::kCylinder,
+                   makeIsometry(Eigen::Matrix3d::Identity(), {2.0, 3.5, 0.0}),
+                   Eigen::Vector3d(1 / 0.2, 1 / 0.2, 1)),
+      QuadricModel(
+          QuadricClass::kCone,
+          makeIsometry(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix(),
+                       {3.0, 3.0, 1.5}),
+          Eigen::Vector3d(1 / std::tan(0.4), 1 / std::tan(0.4), 1))};
   std::vector<QuadricModel> quadrics = truth_quadrics;
   // The plane: y = 4 (normal = world y).
-  quadrics[0] =
-      QuadricModel(QuadricClass::kPlane,
-              makeIsometry(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
-                           {0, 4, 0}),
-              Eigen::Vector3d::Ones());
+  quadrics[0] = QuadricModel(
+      QuadricClass::kPlane,
+      makeIsometry(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix(),
+                   {0, 4, 0}),
+      Eigen::Vector3d::Ones());
   const std::vector<QuadricModel> truth = {quadrics[0], truth_quadrics[1], truth_quadrics[2],
-                                      truth_quadrics[3]};
+                                           truth_quadrics[3]};
 
   const double sigma_odom_t = 0.01, sigma_odom_r = 0.005, sigma_obs = 0.01;
   Matrix6d odom_cov = Matrix6d::Zero();

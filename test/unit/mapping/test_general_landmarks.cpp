@@ -4,9 +4,9 @@
 // relabelling of its axes (geometry/symmetry.h: the scales follow their axes): the observation
 // factor's Jacobians match numeric differentiation with the 9-parameter manifold; one ellipsoid
 // seen from many poses becomes exactly one landmark (promoted after 5 observations) whose semi-axes
-// converge within 5 mm; two landmarks of one ellipsoid merge (chi-square in the 9-dim minimal space)
-// into one no less certain than either, while another ellipsoid beside it, or one 3 cm larger at
-// the same place, stays apart.
+// converge within 5 mm; two landmarks of one ellipsoid merge (chi-square in the 9-dim minimal
+// space) into one no less certain than either, while another ellipsoid beside it, or one 3 cm
+// larger at the same place, stays apart.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -15,6 +15,7 @@
 #include <memory>
 #include <random>
 
+#include "cost_jacobian_checks.h"
 #include "quadric_slam/eval/map_metrics.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
 #include "quadric_slam/geometry/manifolds.h"
@@ -26,8 +27,6 @@
 
 namespace quadric_slam {
 namespace {
-
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 const Eigen::Vector4d kEllipsoid(1, 1, 1, -1);
 
@@ -65,20 +64,14 @@ QuadricMeasurement measureRelabelled(const test::TrueLandmark& l, const Eigen::I
   return m;
 }
 
-Eigen::VectorXd evaluate(const ceres::CostFunction& cost, const std::vector<const double*>& args) {
-  Eigen::VectorXd r(cost.num_residuals());
-  cost.Evaluate(args.data(), r.data(), nullptr);
-  return r;
-}
-
 TEST(GeneralLandmarks, ObservationJacobiansMatchNumericWithRelabelledMeasurements) {
   std::mt19937 rng(61);
   PoseManifold pose_manifold;
   QuadricManifold quadric_manifold(QuadricClass::kGeneral);
   const std::vector<const ceres::Manifold*> manifolds = {&pose_manifold, &quadric_manifold};
   for (int trial = 0; trial < 20; ++trial) {
-    const test::TrueLandmark truth = ellipsoid(test::randomVector(rng, 1.0), test::uniform(rng, -3, 3),
-                                               Eigen::Vector3d(0.3, 0.2, 0.12));
+    const test::TrueLandmark truth = ellipsoid(
+        test::randomVector(rng, 1.0), test::uniform(rng, -3, 3), Eigen::Vector3d(0.3, 0.2, 0.12));
     const Eigen::Isometry3d T_WC = test::randomPose(rng);
     const QuadricMeasurement m = measureRelabelled(truth, T_WC, rng);
     std::unique_ptr<ceres::CostFunction> cost(
@@ -95,33 +88,11 @@ TEST(GeneralLandmarks, ObservationJacobiansMatchNumericWithRelabelledMeasurement
       xi[i] = test::uniform(rng, -0.01, 0.01);
     poseToParameters(plus(T_WC, xi), pose.data());
     quadricToParameters(truth.quadric_world.plusMinimal(d), quadric.data());
-    const std::vector<const double*> blocks = {pose.data(), quadric.data()};
-    const Eigen::VectorXd r = evaluate(*cost, blocks);
+    const Eigen::VectorXd r = test::evaluate(*cost, {pose.data(), quadric.data()});
     ASSERT_TRUE(r.allFinite());
     EXPECT_LT(r.norm(), 40.0) << "trial " << trial << ": the relabelling was not undone";
-    std::vector<RowMajor> jac = {RowMajor(9, kPoseParameterSize),
-                                 RowMajor(9, kQuadricParameterSize)};
-    double* jac_ptrs[2] = {jac[0].data(), jac[1].data()};
-    Eigen::VectorXd r2(9);
-    ASSERT_TRUE(cost->Evaluate(blocks.data(), r2.data(), jac_ptrs));
-    for (int b = 0; b < 2; ++b) {
-      const ceres::Manifold& man = *manifolds[b];
-      const int n = man.AmbientSize(), k = man.TangentSize();
-      RowMajor plus_j(n, k);
-      man.PlusJacobian(blocks[b], plus_j.data());
-      const Eigen::MatrixXd analytic = jac[b] * plus_j;
-      const Eigen::MatrixXd numeric = test::numericJacobian(
-          [&](const Eigen::VectorXd& delta) -> Eigen::VectorXd {
-            std::vector<double> moved(n);
-            man.Plus(blocks[b], delta.data(), moved.data());
-            std::vector<const double*> args = blocks;
-            args[b] = moved.data();
-            return evaluate(*cost, args);
-          },
-          k);
-      EXPECT_LT(test::relativeError(analytic, numeric), 1e-6) << "trial " << trial << " block "
-                                                              << b;
-    }
+    test::expectCostJacobians(*cost, {pose.data(), quadric.data()}, manifolds,
+                              "trial " + std::to_string(trial) + " ");
   }
 }
 
