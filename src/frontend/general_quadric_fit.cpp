@@ -25,23 +25,36 @@ double value(const Vector10d& c, const Eigen::Vector3d& x, Eigen::Vector3d* grad
   return c.dot(monomials(x));
 }
 
-double sampson(const Vector10d& c, const Eigen::Vector3d& x) {
-  Eigen::Vector3d g;
-  const double f = value(c, x, &g);
-  return f / std::max(g.norm(), 1e-12);
-}
-
 Eigen::VectorXd residuals(const Vector10d& c, const std::vector<Eigen::Vector3d>& x) {
   Eigen::VectorXd r(x.size());
   for (std::size_t i = 0; i < x.size(); ++i)
-    r[i] = sampson(c, x[i]);
+    r[i] = sampsonDistance(c, x[i]);
   return r;
 }
 
 }  // namespace
 
+double sampsonDistance(const Vector10d& c, const Eigen::Vector3d& x, Vector10d* jacobian) {
+  Eigen::Vector3d g;
+  const double f = value(c, x, &g);
+  const double norm = g.norm();
+  if (norm < 1e-12) {  // the floor: f / 1e-12, linear in c
+    if (jacobian)
+      *jacobian = monomials(x) / 1e-12;
+    return f / 1e-12;
+  }
+  if (jacobian) {
+    // (grad f)^T d(grad f)/dc_j, column by column of G(x) (see value()).
+    Vector10d gG;
+    gG << 2 * g.x() * x.x(), 2 * g.y() * x.y(), 2 * g.z() * x.z(), g.x() * x.y() + g.y() * x.x(),
+        g.x() * x.z() + g.z() * x.x(), g.y() * x.z() + g.z() * x.y(), g.x(), g.y(), g.z(), 0.0;
+    *jacobian = monomials(x) / norm - f * gG / (norm * norm * norm);
+  }
+  return f / norm;
+}
+
 double GeneralQuadricFit::distance(const Eigen::Vector3d& p) const {
-  return spread * sampson(coefficients, (p - centre) / spread);
+  return spread * sampsonDistance(coefficients, (p - centre) / spread);
 }
 
 Eigen::Vector3d GeneralQuadricFit::gradientDirection(const Eigen::Vector3d& p) const {
@@ -89,12 +102,10 @@ GeneralQuadricFit fitGeneralQuadric(const std::vector<Eigen::Vector3d>& all_poin
   double lambda = 1e-3;
   for (int it = 0; it < iterations; ++it) {
     Eigen::MatrixXd J(x.size(), 10);
-    constexpr double h = 1e-7;
-    for (int j = 0; j < 10; ++j) {
-      Vector10d cp = c, cm = c;
-      cp[j] += h;
-      cm[j] -= h;
-      J.col(j) = (residuals(cp, x) - residuals(cm, x)) / (2 * h);
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      Vector10d row;
+      sampsonDistance(c, x[i], &row);
+      J.row(static_cast<Eigen::Index>(i)) = row.transpose();
     }
     const Eigen::MatrixXd H = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * r;

@@ -158,6 +158,49 @@ double PrimitiveShape::curvedDistance(const Eigen::Vector3d& p) const {
   }
 }
 
+Eigen::Matrix<double, 7, 1> PrimitiveShape::distanceGradient(const Eigen::Vector3d& p) const {
+  // Rows: d/d point (3), d/d direction (3), d/d size. v = p - point; for the axial classes
+  // z = direction.v (height along the axis) and w = v - z direction (the radial part, |w| = rho).
+  Eigen::Matrix<double, 7, 1> g = Eigen::Matrix<double, 7, 1>::Zero();
+  const Eigen::Vector3d v = p - point;
+  switch (quadric_class) {
+    case QuadricClass::kPlane:  // d = n.v
+      g.head<3>() = -direction;
+      g.segment<3>(3) = v;
+      return g;
+    case QuadricClass::kSphere: {  // d = |v| - r
+      const double norm = v.norm();
+      if (norm > 0)
+        g.head<3>() = -v / norm;
+      g[6] = -1;
+      return g;
+    }
+    case QuadricClass::kCylinder:
+    case QuadricClass::kCone: {
+      const double z = direction.dot(v);
+      const Eigen::Vector3d w = v - z * direction;
+      const double rho = w.norm();
+      // d rho / d v = w^T / rho (w is orthogonal to the axis); d rho / d direction = -z w^T / rho.
+      const Eigen::Vector3d radial = rho > 0 ? Eigen::Vector3d(w / rho) : Eigen::Vector3d::Zero();
+      if (quadric_class == QuadricClass::kCylinder) {  // d = rho - r
+        g.head<3>() = -radial;
+        g.segment<3>(3) = -z * radial;
+        g[6] = -1;
+        return g;
+      }
+      // d = rho cos(a) - z sin(a), a the half angle; d z / d v = direction^T, d z / d direction =
+      // v^T.
+      const double c = std::cos(size), s = std::sin(size);
+      g.head<3>() = -(c * radial - s * direction);
+      g.segment<3>(3) = -c * z * radial - s * v;
+      g[6] = -rho * s - z * c;
+      return g;
+    }
+    default:
+      throw std::invalid_argument("distanceGradient: not defined for a general quadric");
+  }
+}
+
 Eigen::Vector3d PrimitiveShape::curvedNormalAt(const Eigen::Vector3d& p) const {
   const Eigen::Vector3d v = p - point;
   switch (quadric_class) {

@@ -2,8 +2,10 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -620,7 +622,15 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
   cgal.random_seed = p.random_seed;
   std::vector<Eigen::Vector3d> sample_points, sample_normals;
   std::vector<int> sample_pixel;
-  std::vector<CgalShapeDetector::Shape> candidates;
+  // Each component's sample is a contiguous range of the sample arrays.
+  struct ComponentJob {
+    std::size_t first = 0;
+    int count = 0;
+    int min_points = 0;
+    std::vector<CgalShapeDetector::Shape> shapes;
+    std::exception_ptr error;
+  };
+  std::vector<ComponentJob> jobs;
   for (const std::vector<int>& component : freeComponents(frame, p)) {
     if (static_cast<int>(component.size()) < p.min_curved_points)
       continue;
@@ -636,26 +646,38 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
       sample_normals.push_back(normalOf(cloud.points[i]).normalized());
       sample_pixel.push_back(i);
     }
-    const int count = static_cast<int>(sample_points.size() - first);
-    cgal.min_points =
-        std::max(p.cgal_min_points, static_cast<int>(std::ceil(p.cgal_min_fraction * count)));
-    if (count < cgal.min_points)
+    ComponentJob job;
+    job.first = first;
+    job.count = static_cast<int>(sample_points.size() - first);
+    job.min_points =
+        std::max(p.cgal_min_points, static_cast<int>(std::ceil(p.cgal_min_fraction * job.count)));
+    if (job.count < job.min_points) {
+      sample_points.resize(first);
+      sample_normals.resize(first);
+      sample_pixel.resize(first);
       continue;
-    const std::vector<Eigen::Vector3d> points(sample_points.begin() + first, sample_points.end());
-    const std::vector<Eigen::Vector3d> normals(sample_normals.begin() + first,
-                                               sample_normals.end());
-    std::vector<CgalShapeDetector::Shape> shapes = CgalShapeDetector(cgal).detect(points, normals);
+    }
+    jobs.push_back(std::move(job));
+  }
+  auto detectComponent = [&](ComponentJob& job) {
+    CgalShapeDetector::Params params = cgal;
+    params.min_points = job.min_points;
+    const std::vector<Eigen::Vector3d> points(sample_points.begin() + job.first,
+                                              sample_points.begin() + job.first + job.count);
+    const std::vector<Eigen::Vector3d> normals(sample_normals.begin() + job.first,
+                                               sample_normals.begin() + job.first + job.count);
+    job.shapes = CgalShapeDetector(params).detect(points, normals);
     // CGAL's planes only absorb flat patches. A plane on points whose normals bend (curvature above
     // the grower's max_curvature) is a curved surface whose sag the depth noise hides (a far,
     // narrow strip of a cylinder fits a plane within epsilon): it becomes a cylinder candidate
     // fitted to the normals (model selection may turn it into a cone or sphere).
-    for (CgalShapeDetector::Shape& shape : shapes) {
+    for (CgalShapeDetector::Shape& shape : job.shapes) {
       if (shape.shape.quadric_class != QuadricClass::kPlane)
         continue;
       std::vector<int> pixels;
       std::vector<Eigen::Vector3d> support, support_normals;
       for (int k : shape.indices) {
-        pixels.push_back(sample_pixel[first + k]);
+        pixels.push_back(sample_pixel[job.first + k]);
         support.push_back(points[k]);
         support_normals.push_back(normals[k]);
       }
@@ -669,11 +691,29 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
           rmsDistance(cylinder, support) < rmsDistance(shape.shape, support))
         shape.shape = cylinder;
     }
-    for (CgalShapeDetector::Shape& shape : shapes) {
+    for (CgalShapeDetector::Shape& shape : job.shapes)
       for (int& k : shape.indices)
-        k += static_cast<int>(first);
-      candidates.push_back(std::move(shape));
+        k += static_cast<int>(job.first);
+  };
+  // The components are independent inputs: CGAL runs on them in parallel, each thread taking the
+  // next component. CGAL's random generator is thread-local and reseeded per call, so the result
+  // does not depend on the number of threads.
+  std::atomic<std::size_t> next_job{0};
+  forEachChunk(p.threads, p.threads, [&](int, int, int) {
+    for (std::size_t j = next_job++; j < jobs.size(); j = next_job++) {
+      try {
+        detectComponent(jobs[j]);
+      } catch (...) {  // rethrown on the calling thread below
+        jobs[j].error = std::current_exception();
+      }
     }
+  });
+  std::vector<CgalShapeDetector::Shape> candidates;
+  for (ComponentJob& job : jobs) {
+    if (job.error)
+      std::rethrow_exception(job.error);
+    for (CgalShapeDetector::Shape& shape : job.shapes)
+      candidates.push_back(std::move(shape));
   }
   std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
     return a.indices.size() > b.indices.size();

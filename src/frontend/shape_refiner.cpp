@@ -45,7 +45,8 @@ Eigen::VectorXd residuals(const PrimitiveShape& shape, const std::vector<Eigen::
 }
 
 // Jacobian of the distances with respect to the minimal coordinates, by central differences.
-Eigen::MatrixXd jacobian(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
+Eigen::MatrixXd numericJacobian(const PrimitiveShape& shape,
+                                const std::vector<Eigen::Vector3d>& points) {
   const int k = minimalDimension(shape.quadric_class);
   Eigen::MatrixXd J(points.size(), k);
   constexpr double h = 1e-6;
@@ -58,6 +59,12 @@ Eigen::MatrixXd jacobian(const PrimitiveShape& shape, const std::vector<Eigen::V
     J.col(j) = (plus - minus) / (2 * h);
   }
   return J;
+}
+
+Eigen::Matrix<double, 7, 1> parametersOf(const PrimitiveShape& shape) {
+  Eigen::Matrix<double, 7, 1> x;
+  x << shape.point, shape.direction, shape.size;
+  return x;
 }
 
 std::vector<Eigen::Vector3d> subsample(const std::vector<Eigen::Vector3d>& all_points,
@@ -80,7 +87,7 @@ ShapeRefiner::Result covarianceOf(const PrimitiveShape& shape,
   ShapeRefiner::Result result;
   const int k = minimalDimension(shape.quadric_class);
   const double cost = residuals(shape, points).squaredNorm();
-  const Eigen::MatrixXd J = jacobian(shape, points);
+  const Eigen::MatrixXd J = distanceJacobian(shape, points);
   Eigen::MatrixXd H = J.transpose() * J;
   H *= static_cast<double>(all_points) / static_cast<double>(points.size());
   const double sigma2 = cost / (static_cast<double>(points.size()) - k);
@@ -125,7 +132,7 @@ ShapeRefiner::Result ShapeRefiner::refineUnchecked(
   double cost = r.squaredNorm();
   double lambda = 1e-4;
   for (int it = 0; it < params_.max_iterations; ++it) {
-    const Eigen::MatrixXd J = jacobian(shape, points);
+    const Eigen::MatrixXd J = distanceJacobian(shape, points);
     const Eigen::MatrixXd H = J.transpose() * J;
     const Eigen::VectorXd g = J.transpose() * r;
     bool improved = false;
@@ -176,6 +183,29 @@ ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
   } catch (const std::invalid_argument&) {
     return result;
   }
+}
+
+Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
+                                 const std::vector<Eigen::Vector3d>& points) {
+  if (shape.quadric_class == QuadricClass::kGeneral)
+    return numericJacobian(shape, points);
+  // The perturbation acts on the shape's core quadric, whose own (point, direction) may differ from
+  // shape's (e.g. a plane's point is the quadric origin offset * normal): differentiate at it.
+  const int k = minimalDimension(shape.quadric_class);
+  const PrimitiveShape base = PrimitiveShape::fromQuadric(shape.quadric());
+  Eigen::Matrix<double, 7, Eigen::Dynamic> D(7, k);
+  constexpr double h = 1e-6;
+  for (int j = 0; j < k; ++j) {
+    Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
+    delta[j] = h;
+    const Eigen::Matrix<double, 7, 1> plus = parametersOf(perturb(shape, delta));
+    delta[j] = -h;
+    D.col(j) = (plus - parametersOf(perturb(shape, delta))) / (2 * h);
+  }
+  Eigen::MatrixXd J(points.size(), k);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    J.row(static_cast<Eigen::Index>(i)) = base.distanceGradient(points[i]).transpose() * D;
+  return J;
 }
 
 PrimitiveShape fitPlane(const std::vector<Eigen::Vector3d>& points) {

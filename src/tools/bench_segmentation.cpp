@@ -1,12 +1,13 @@
 // bench_segmentation: time of QuadricSegmenter per 640x480 frame (normals excluded) over the real
-// frames in ../shared/data (OSD mosd_cylinders PCDs, TUM depth PNGs) and rendered synthetic frames,
-// against the baseline the paper uses: CGAL Efficient RANSAC with plane, sphere, cylinder and cone
-// on all points of the full frame.
+// frames in ../shared/data (OSD mosd_cylinders PCDs, TUM depth PNGs), every K-th frame of the real
+// 7-Scenes kitchen sequence, and rendered synthetic frames, against the baseline the paper uses:
+// CGAL Efficient RANSAC with plane, sphere, cylinder and cone on all points of the full frame.
 //
 //   bench_segmentation [--data DIR] [--repeats N (3)] [--synthetic N (10)] [--baseline-frames N
-//   (8)]
+//   (8)] [--kitchen-every K (50; 0: no kitchen frames)]
 //
-// Prints median and p95 per set, the baseline's, their ratio, and the machine load (uptime).
+// Prints median and p95 per set and per stage, plane and curved segments per frame per set, the
+// baseline's time, their ratio, and the machine load (uptime).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -97,6 +98,30 @@ std::vector<Frame> realFrames(const std::string& data, const qs::NormalEstimator
   return frames;
 }
 
+// Every K-th depth frame of the 7-Scenes kitchen (TUM layout, depth intrinsics 585/585/320/240).
+std::vector<Frame> kitchenFrames(const std::string& data, int every,
+                                 const qs::NormalEstimator& normals) {
+  std::vector<Frame> frames;
+  const fs::path dir = fs::path(data) / "7scenes_redkitchen";
+  if (every <= 0 || !fs::exists(dir / "depth.txt"))
+    return frames;
+  const qs::CameraIntrinsics k = intrinsics(585, 585, 320, 240);
+  std::ifstream list(dir / "depth.txt");
+  std::string line;
+  int i = 0;
+  while (std::getline(list, line)) {
+    if (line.empty() || line[0] == '#')
+      continue;
+    if (i++ % every != 0)
+      continue;
+    const std::string file = line.substr(line.find(' ') + 1);
+    frames.push_back(
+        {"kitchen_" + std::to_string(i - 1),
+         normals.compute(qs::loadOrganizedCloud((dir / file).string(), k, 5000.0))});
+  }
+  return frames;
+}
+
 // Desk-like rendered scenes: floor, wall, and a sphere, cylinder and cone at random places.
 std::vector<Frame> syntheticFrames(int count, const qs::NormalEstimator& normals) {
   std::vector<Frame> frames;
@@ -167,7 +192,7 @@ void report(const char* name, const std::vector<double>& times) {
 
 int main(int argc, char** argv) {
   std::string data = QUADRIC_SLAM_SHARED_DATA_DIR;
-  int repeats = 3, synthetic = 10, baseline_frames = 8;
+  int repeats = 3, synthetic = 10, baseline_frames = 8, kitchen_every = 50;
   qs::QuadricSegmenter::Params params;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i], value = argv[i + 1];
@@ -179,6 +204,8 @@ int main(int argc, char** argv) {
       synthetic = std::atoi(value.c_str());
     else if (arg == "--baseline-frames")
       baseline_frames = std::atoi(value.c_str());
+    else if (arg == "--kitchen-every")
+      kitchen_every = std::atoi(value.c_str());
     else if (arg == "--config")
       params = qs::loadSegmenterParams(value);
     else if (arg == "--set" && value.find('=') != std::string::npos)
@@ -187,26 +214,38 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: bench_segmentation [--data DIR] [--repeats N] [--synthetic N] "
-                   "[--baseline-frames N] [--config segmentation.yaml] [--set KEY=VALUE]...\n");
+                   "[--baseline-frames N] [--kitchen-every K] [--config segmentation.yaml] [--set KEY=VALUE]...\n");
       return 2;
     }
   }
   const qs::NormalEstimator normals{qs::NormalEstimator::Params()};
   const qs::QuadricSegmenter segmenter(params);
   const std::vector<Frame> real = realFrames(data, normals);
+  const std::vector<Frame> kitchen = kitchenFrames(data, kitchen_every, normals);
   const std::vector<Frame> synth = syntheticFrames(synthetic, normals);
-  std::printf("frames: %zu real (%s), %zu synthetic; %d repeats each\n", real.size(), data.c_str(),
-              synth.size(), repeats);
+  std::printf("frames: %zu real (%s), %zu kitchen (every %d-th), %zu synthetic; %d repeats each\n",
+              real.size(), data.c_str(), kitchen.size(), kitchen_every, synth.size(), repeats);
 
-  std::vector<double> real_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms, upsample_ms,
+  // Segments per frame, per set: planes and curved (sphere, cylinder, cone, general).
+  struct Counts {
+    double frames = 0, planes = 0, curved = 0, ransac_points = 0, candidates = 0;
+  };
+  Counts real_counts, kitchen_counts, synth_counts;
+  std::vector<double> real_ms, kitchen_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms, upsample_ms,
       boundary_ms;
   for (int r = 0; r < repeats; ++r) {
-    for (const auto* set : {&real, &synth}) {
+    for (const auto* set : {&real, &kitchen, &synth}) {
       for (const Frame& f : *set) {
         const auto t0 = Clock::now();
         const qs::Segmentation s = segmenter.segment(f.cloud);
         const double t = ms(t0, Clock::now());
-        (set == &real ? real_ms : synth_ms).push_back(t);
+        (set == &real ? real_ms : set == &kitchen ? kitchen_ms : synth_ms).push_back(t);
+        Counts& counts = set == &real ? real_counts : set == &kitchen ? kitchen_counts : synth_counts;
+        counts.frames += 1;
+        counts.ransac_points += s.timings.ransac_points;
+        counts.candidates += s.timings.ransac_candidates;
+        for (const qs::QuadricDetection& d : s.detections)
+          (d.shape.quadric_class == qs::QuadricClass::kPlane ? counts.planes : counts.curved) += 1;
         all_ms.push_back(t);
         planes_ms.push_back(s.timings.planes_ms);
         ransac_ms.push_back(s.timings.ransac_ms);
@@ -218,14 +257,17 @@ int main(int argc, char** argv) {
   }
   std::vector<double> base_ms;
   std::size_t base_shapes = 0;
-  const std::size_t step =
-      std::max<std::size_t>(1, (real.size() + synth.size()) / std::max(1, baseline_frames));
+  const std::size_t step = std::max<std::size_t>(
+      1, (real.size() + kitchen.size() + synth.size()) / std::max(1, baseline_frames));
   std::vector<const Frame*> everything;
   for (const auto& f : real)
     everything.push_back(&f);
+  for (const auto& f : kitchen)
+    everything.push_back(&f);
   for (const auto& f : synth)
     everything.push_back(&f);
-  for (std::size_t i = 0; i < everything.size(); i += step) {
+  for (std::size_t i = 0;
+       i < everything.size() && static_cast<int>(base_ms.size()) < baseline_frames; i += step) {
     std::size_t shapes = 0;
     base_ms.push_back(baselineMs(everything[i]->cloud, shapes));
     base_shapes += shapes;
@@ -233,6 +275,7 @@ int main(int argc, char** argv) {
 
   std::printf("QuadricSegmenter (normals excluded):\n");
   report("  real frames", real_ms);
+  report("  kitchen frames", kitchen_ms);
   report("  synthetic frames", synth_ms);
   report("  all frames", all_ms);
   report("    stage: planes", planes_ms);
@@ -240,11 +283,20 @@ int main(int argc, char** argv) {
   report("    stage: verification", verify_ms);
   report("    stage: upsampling", upsample_ms);
   report("    stage: boundary", boundary_ms);
-  std::printf("Baseline, CGAL Efficient RANSAC, 4 shapes, full frame (%zu shapes total):\n",
-              base_shapes);
-  report("  baseline frames", base_ms);
-  std::printf("speed-up (baseline median / all-frames median): %.1fx\n",
-              percentile(base_ms, 0.5) / std::max(1e-9, percentile(all_ms, 0.5)));
+  for (const auto& [name, c] : {std::pair<const char*, Counts>{"real", real_counts},
+                                {"kitchen", kitchen_counts}, {"synthetic", synth_counts}})
+    if (c.frames > 0)
+      std::printf("  per frame, %-9s  segments: planes %5.1f  curved %5.1f;  RANSAC input %6.0f "
+                  "points, %5.1f candidates\n",
+                  name, c.planes / c.frames, c.curved / c.frames, c.ransac_points / c.frames,
+                  c.candidates / c.frames);
+  if (!base_ms.empty()) {
+    std::printf("Baseline, CGAL Efficient RANSAC, 4 shapes, full frame (%zu shapes total):\n",
+                base_shapes);
+    report("  baseline frames", base_ms);
+    std::printf("speed-up (baseline median / all-frames median): %.1fx\n",
+                percentile(base_ms, 0.5) / std::max(1e-9, percentile(all_ms, 0.5)));
+  }
   std::ifstream loadavg("/proc/loadavg");
   std::string l1, l5, l15;
   loadavg >> l1 >> l5 >> l15;

@@ -25,6 +25,12 @@ struct GeneralQuadricFit {
   Eigen::Vector3d gradientDirection(const Eigen::Vector3d& p) const;
 };
 
+// The Sampson distance f(x) / |grad f(x)| of a normalised point x for coefficients c, and (when
+// jacobian is given) its derivative in c: f = c.m(x) and grad f = G(x) c are linear in c, so
+// d/dc = m / |grad f| - f (grad f)^T G / |grad f|^3 (the fit's analytic Jacobian row).
+double sampsonDistance(const Eigen::Matrix<double, 10, 1>& c, const Eigen::Vector3d& x,
+                       Eigen::Matrix<double, 10, 1>* jacobian = nullptr);
+
 // Uses at most max_points points (an even sub-sample). Iterations of the Sampson refinement >= 0.
 GeneralQuadricFit fitGeneralQuadric(const std::vector<Eigen::Vector3d>& points,
                                     int max_points = 600, int iterations = 8);

@@ -70,6 +70,11 @@ struct PrimitiveShape {
   Eigen::Vector3d normalAt(const Eigen::Vector3d& p) const {
     return quadric_class == QuadricClass::kPlane ? direction : curvedNormalAt(p);
   }
+  // Gradient of distance(p) with respect to the shape's own parameters (point, direction, size),
+  // direction taken as a free 3-vector: the per-point factor of the refiner's analytic Jacobian
+  // (shape_refiner.h distanceJacobian). Plane, sphere, cylinder and cone; throws
+  // std::invalid_argument for a general quadric.
+  Eigen::Matrix<double, 7, 1> distanceGradient(const Eigen::Vector3d& p) const;
   // distance() and normalAt() of the other classes.
   double curvedDistance(const Eigen::Vector3d& p) const;
   Eigen::Vector3d curvedNormalAt(const Eigen::Vector3d& p) const;

@@ -73,3 +73,30 @@ TEST(GeneralQuadricFit, SeparatesAnEllipsoidFromASphere) {
 TEST(GeneralQuadricFit, TooFewPointsIsNotOk) {
   EXPECT_FALSE(qs::fitGeneralQuadric(std::vector<Eigen::Vector3d>(10, Eigen::Vector3d::Ones())).ok);
 }
+
+// The fit's analytic Jacobian row (d Sampson distance / d coefficients) against central differences,
+// at random coefficients and points.
+TEST(GeneralQuadricFit, SampsonJacobianMatchesNumericDifferentiation) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> uni(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::Matrix<double, 10, 1> c;
+    for (int j = 0; j < 10; ++j)
+      c[j] = uni(rng);
+    c.normalize();
+    const Eigen::Vector3d x(uni(rng), uni(rng), uni(rng));
+    Eigen::Matrix<double, 10, 1> analytic;
+    const double r = qs::sampsonDistance(c, x, &analytic);
+    EXPECT_DOUBLE_EQ(r, qs::sampsonDistance(c, x));
+    constexpr double h = 1e-7;
+    for (int j = 0; j < 10; ++j) {
+      Eigen::Matrix<double, 10, 1> plus = c, minus = c;
+      plus[j] += h;
+      minus[j] -= h;
+      const double numeric =
+          (qs::sampsonDistance(plus, x) - qs::sampsonDistance(minus, x)) / (2 * h);
+      EXPECT_NEAR(analytic[j], numeric, 1e-5 * (1 + std::abs(numeric)))
+          << "trial " << trial << " coefficient " << j;
+    }
+  }
+}

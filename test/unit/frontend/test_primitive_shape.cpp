@@ -226,3 +226,51 @@ TEST(PrimitiveShape, PerturbThrowsWhenTheScaleStepLeavesTheClass) {
   sphere_step[3] = -10;  // alpha 10 -> 0
   EXPECT_THROW(perturb(sphere, sphere_step), std::invalid_argument);
 }
+
+// The refiner's analytic Jacobian (per-point gradient chained through perturb) against central
+// differences of the distances through perturb, for every class at points on, in front of and
+// behind the surface; and distanceGradient itself against differences in (point, direction, size).
+TEST(ShapeRefiner, AnalyticDistanceJacobianMatchesNumericDifferentiation) {
+  std::mt19937 rng(17);
+  std::normal_distribution<double> off_surface(0.0, 0.02);
+  for (const PrimitiveShape& s : someShapes()) {
+    std::vector<Eigen::Vector3d> points = surfaceSamples(s, 60, 3);
+    for (Eigen::Vector3d& p : points)
+      p += off_surface(rng) * s.normalAt(p);
+    const int k = qs::minimalDimension(s.quadric_class);
+    const Eigen::MatrixXd J = qs::distanceJacobian(s, points);
+    ASSERT_EQ(J.rows(), static_cast<Eigen::Index>(points.size()));
+    ASSERT_EQ(J.cols(), k);
+    constexpr double h = 1e-6;
+    for (int j = 0; j < k; ++j) {
+      Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
+      delta[j] = h;
+      const PrimitiveShape plus = qs::perturb(s, delta);
+      delta[j] = -h;
+      const PrimitiveShape minus = qs::perturb(s, delta);
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const double numeric = (plus.distance(points[i]) - minus.distance(points[i])) / (2 * h);
+        EXPECT_NEAR(J(static_cast<Eigen::Index>(i), j), numeric, 1e-6 * (1 + std::abs(numeric)))
+            << qs::toString(s.quadric_class) << " point " << i << " coordinate " << j;
+      }
+    }
+    // distanceGradient in the shape's own parameters.
+    const Eigen::Vector3d probe = points[7];
+    const Eigen::Matrix<double, 7, 1> g = s.distanceGradient(probe);
+    for (int j = 0; j < 7; ++j) {
+      PrimitiveShape a = s, b = s;
+      if (j < 3) {
+        a.point[j] += h;
+        b.point[j] -= h;
+      } else if (j < 6) {
+        a.direction[j - 3] += h;
+        b.direction[j - 3] -= h;
+      } else {
+        a.size += h;
+        b.size -= h;
+      }
+      EXPECT_NEAR(g[j], (a.distance(probe) - b.distance(probe)) / (2 * h), 1e-6)
+          << qs::toString(s.quadric_class) << " parameter " << j;
+    }
+  }
+}
