@@ -2,9 +2,12 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "quadric_slam/geometry/quadric_classes.h"
 
 namespace quadric_slam {
 
@@ -61,10 +64,30 @@ Eigen::MatrixXd numericJacobian(const PrimitiveShape& shape,
   return J;
 }
 
-Eigen::Matrix<double, 7, 1> parametersOf(const PrimitiveShape& shape) {
-  Eigen::Matrix<double, 7, 1> x;
-  x << shape.point, shape.direction, shape.size;
-  return x;
+// d (point, direction, size) / d delta at delta = 0 for the minimal perturbation of a plane,
+// sphere, cylinder or cone quadric (QuadricModel::plusMinimal: T exp(xi) with xi = (rho, phi),
+// eqs. 9 and 16, and alpha + s on the scale, mapped from the class's Table II coordinates by its
+// basis). At zero: d t / d rho = R; the axis R e_c (c = x for a plane's normal, z for an axis)
+// moves as d (R e_c) / d phi = -R [e_c]x; a radius 1 / alpha_x moves by -r^2 per unit of alpha_x,
+// a cone's half angle atan(1 / alpha_x) by -1 / (1 + alpha_x^2).
+Eigen::Matrix<double, 7, Eigen::Dynamic> shapeParameterJacobian(const QuadricModel& quadric) {
+  const Eigen::Matrix3d R = quadric.pose().linear();
+  const QuadricClass c = quadric.quadricClass();
+  Eigen::Matrix<double, 7, 9> full = Eigen::Matrix<double, 7, 9>::Zero();
+  full.block<3, 3>(0, 0) = R;
+  if (c == QuadricClass::kPlane || c == QuadricClass::kCylinder || c == QuadricClass::kCone) {
+    const Eigen::Vector3d axis =
+        c == QuadricClass::kPlane ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitZ();
+    Eigen::Matrix3d cross;
+    cross << 0, -axis.z(), axis.y(), axis.z(), 0, -axis.x(), -axis.y(), axis.x(), 0;
+    full.block<3, 3>(3, 3) = -R * cross;
+  }
+  const double alpha = quadric.scale().x();
+  if (c == QuadricClass::kSphere || c == QuadricClass::kCylinder)
+    full(6, 6) = -1.0 / (alpha * alpha);
+  else if (c == QuadricClass::kCone)
+    full(6, 6) = -1.0 / (1.0 + alpha * alpha);
+  return full * classDefinition(c).basis;
 }
 
 std::vector<Eigen::Vector3d> subsample(const std::vector<Eigen::Vector3d>& all_points,
@@ -191,17 +214,10 @@ Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
     return numericJacobian(shape, points);
   // The perturbation acts on the shape's core quadric, whose own (point, direction) may differ from
   // shape's (e.g. a plane's point is the quadric origin offset * normal): differentiate at it.
-  const int k = minimalDimension(shape.quadric_class);
-  const PrimitiveShape base = PrimitiveShape::fromQuadric(shape.quadric());
-  Eigen::Matrix<double, 7, Eigen::Dynamic> D(7, k);
-  constexpr double h = 1e-6;
-  for (int j = 0; j < k; ++j) {
-    Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
-    delta[j] = h;
-    const Eigen::Matrix<double, 7, 1> plus = parametersOf(perturb(shape, delta));
-    delta[j] = -h;
-    D.col(j) = (plus - parametersOf(perturb(shape, delta))) / (2 * h);
-  }
+  const QuadricModel quadric = shape.quadric();
+  const PrimitiveShape base = PrimitiveShape::fromQuadric(quadric);
+  const Eigen::Matrix<double, 7, Eigen::Dynamic> D = shapeParameterJacobian(quadric);
+  const int k = static_cast<int>(D.cols());
   Eigen::MatrixXd J(points.size(), k);
   for (std::size_t i = 0; i < points.size(); ++i)
     J.row(static_cast<Eigen::Index>(i)) = base.distanceGradient(points[i]).transpose() * D;

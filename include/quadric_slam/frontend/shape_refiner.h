@@ -52,8 +52,8 @@ class ShapeRefiner {
 
 // Jacobian (points x minimalDimension) of the signed distances of points to shape with respect to
 // the minimal perturbation of primitive_shape.h (perturb, Table II order) at zero. Plane, sphere,
-// cylinder, cone: analytic per point (PrimitiveShape::distanceGradient) chained with the 7 x k
-// derivative of (point, direction, size) through perturb, which involves no points; general:
+// cylinder, cone: analytic, per point PrimitiveShape::distanceGradient chained with the 7 x k
+// derivative of (point, direction, size) in the perturbation (closed form at zero); general:
 // central differences. Throws std::invalid_argument when the shape has no core quadric.
 Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
                                  const std::vector<Eigen::Vector3d>& points);
