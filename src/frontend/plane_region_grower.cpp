@@ -7,6 +7,7 @@
 #include <string>
 
 #include "quadric_slam/frontend/grid_flood.h"
+#include "quadric_slam/frontend/segmentation_frame.h"
 
 namespace quadric_slam {
 
@@ -15,13 +16,6 @@ namespace {
 void require(bool ok, const std::string& message) {
   if (!ok)
     throw std::invalid_argument("PlaneRegionGrower: " + message);
-}
-
-Eigen::Vector3d pointOf(const pcl::PointNormal& p) {
-  return Eigen::Vector3d(p.x, p.y, p.z);
-}
-Eigen::Vector3d normalOf(const pcl::PointNormal& p) {
-  return Eigen::Vector3d(p.normal_x, p.normal_y, p.normal_z);
 }
 
 // Running first and second moments of a growing region, about a fixed reference point.

@@ -1,23 +1,27 @@
 // Quadric segmentation of one depth frame: organized cloud with normals -> planes, spheres,
 // cylinders, cones and ellipsoids (class general) (the paper's front-end, Section IV), each with
-// its least-squares fit,
-// covariance, support and image extent, plus a label image.
+// its least-squares fit, covariance, support and image extent, plus a label image.
 //
-// Pipeline (all in the camera frame):
+// Pipeline (all in the camera frame), one unit per step, segment() the orchestrator:
+//  0. on a grid decimated by Params::decimation (multi_resolution_labels.h), the frame's valid
+//     points (segmentation_frame.h);
 //  1. planes by region growing over the image grid (plane_region_grower.h), flatness-checked;
 //  2. CGAL Efficient RANSAC (Schnabel et al. 2007) with sphere, cylinder, cone (and plane, to
 //     absorb small planar patches) on a sub-sample of each image-grid connected component of
-//     the remaining points; a CGAL plane whose normals bend (the grower's curvature test) becomes
-//     the cylinder its normals describe when that fits better (a far, narrow strip of a cylinder);
-//  3. for each CGAL shape, biggest first: range and degeneracy filters (huge-radius cylinders,
-//     near-flat cones and big spheres are tested against a plane; thin cones against a
-//     cylinder), least-squares refinement, re-assignment of all free full-resolution pixels
-//     near the surface with agreeing normals, the largest image-grid connected component (with
-//     the large ones on the surface's other face: an open bin's inner wall), minimum support,
+//     the remaining points, components in parallel; a CGAL plane whose normals bend (the grower's
+//     curvature test) becomes the cylinder its normals describe when that fits better (a far,
+//     narrow strip of a cylinder) (curved_candidates.h; starting shapes: curved_shape_starts.h);
+//  3. for each CGAL shape, biggest first (curved_verification.h): range and degeneracy filters
+//     (huge-radius cylinders, near-flat cones and big spheres are tested against a plane; thin
+//     cones against a cylinder), least-squares refinement, re-assignment of all free pixels near
+//     the surface with agreeing normals, the largest image-grid connected component (with the
+//     large ones on the surface's other face: an open bin's inner wall), minimum support,
 //     refinement again (shape_refiner.h); near-flat (plane RMS close AND normals not bending
 //     like the shape) and shape (RMS against a general quadric that is a surface) tests; where
 //     the shape test finds an ellipsoid, the ellipsoid is re-assigned, refined and reported
-//     instead (class general, detect_general).
+//     instead (class general, detect_general);
+//  4. the labels brought back to full resolution (multi_resolution_labels.h) and the rim of each
+//     segment, where normals are missing, completed (boundary_labels.h).
 #pragma once
 
 #include <pcl/point_cloud.h>

@@ -1,0 +1,41 @@
+// Starting shapes for the refinement of curved primitives, from points (and their normals): a
+// cylinder from a thin cone, a cone from a cylinder fit, a cone or a cylinder from the normals alone;
+// and a shape's own curvature over its support, which the segmenter compares with the measured
+// normals' bending.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "quadric_slam/frontend/primitive_shape.h"
+
+namespace quadric_slam {
+
+// Cylinder through the points around the cone's axis (the degenerate thin cone).
+PrimitiveShape cylinderFromCone(const PrimitiveShape& cone,
+                                const std::vector<Eigen::Vector3d>& points);
+
+// A cone through the points of a cylinder fit: the radius as a straight line of the axial
+// coordinate, rho = r0 + k z; none (half angle 0) when k vanishes.
+PrimitiveShape coneFromCylinder(const PrimitiveShape& cylinder,
+                                const std::vector<Eigen::Vector3d>& points);
+
+// A cone from points and their normals: every tangent plane passes through the apex
+// (n_i . (apex - p_i) = 0, linear least squares), and the normals lie on a small circle around
+// the axis (the least-variance direction of the centred normals). Catches the side view of a cone,
+// whose visible strip a tilted cylinder also fits. Half angle 0 when degenerate.
+PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
+                               const std::vector<Eigen::Vector3d>& normals);
+
+// A cylinder of the given curvature (1/radius) from points and their normals: the normals are
+// perpendicular to the axis (the least-variance direction of the normals, uncentred), and the axis
+// runs through p -+ r n (the sign that gathers these feet best: normals towards the camera point
+// out of a cylinder's outside and into its inside). Radius 0 when degenerate.
+PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
+                                   const std::vector<Eigen::Vector3d>& normals, double curvature);
+
+// The largest principal curvature of a curved shape over its support (1/m): 1/r for a sphere or
+// cylinder, cos(half angle) / (distance to the axis) for a cone (mean over the points).
+double shapeCurvature(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points);
+
+}  // namespace quadric_slam

@@ -1,0 +1,22 @@
+// Multi-resolution labelling: the segmenter runs on a grid decimated by d (Params::decimation) and
+// brings its segments back to the full-resolution grid.
+#pragma once
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include "quadric_slam/frontend/quadric_segmenter.h"
+
+namespace quadric_slam {
+
+// The parameters of a grid decimated by d: counts of points scale with 1 / d^2, strides with 1 / d.
+QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d);
+
+// Full-resolution labels from a segmentation of the grid decimated by d: each valid pixel takes
+// the label of a neighbouring coarse sample whose surface it fits (distance threshold and normal
+// agreement, as on the coarse grid); support, ROI, extent and covariance follow the full-resolution
+// points.
+Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
+                      const QuadricSegmenter::Params& p);
+
+}  // namespace quadric_slam

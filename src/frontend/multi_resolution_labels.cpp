@@ -1,0 +1,151 @@
+#include "quadric_slam/frontend/multi_resolution_labels.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "quadric_slam/frontend/parallel_chunks.h"
+#include "quadric_slam/frontend/segmentation_frame.h"
+
+namespace quadric_slam {
+
+QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) {
+  QuadricSegmenter::Params c = p;
+  c.planes.min_points = std::max(3, p.planes.min_points / (d * d));
+  c.planes.min_fragment_points = std::max(3, p.planes.min_fragment_points / (d * d));
+  c.min_curved_points = std::max(4, p.min_curved_points / (d * d));
+  c.planes.seed_stride = std::max(1, p.planes.seed_stride / d);
+  c.cgal_stride = std::max(1, (p.cgal_stride + d / 2) / d);
+  c.decimation = 1;
+  return c;
+}
+
+namespace {
+
+bool validPoint(const pcl::PointNormal& q, const QuadricSegmenter::Params& p) {
+  return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+         std::isfinite(q.normal_x) && std::isfinite(q.normal_y) && std::isfinite(q.normal_z) &&
+         q.z >= p.min_range && q.z <= p.max_range;
+}
+
+}  // namespace
+
+Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
+                      const QuadricSegmenter::Params& p) {
+  Segmentation result;
+  result.timings = coarse.timings;
+  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+  result.labels = cv::Mat::zeros(height, width, CV_16UC1);
+  const int n = static_cast<int>(coarse.detections.size());
+  std::vector<Eigen::Isometry3d> T_quadric_camera(n);
+  std::vector<double> cos_angle(n);
+  for (int k = 0; k < n; ++k) {
+    T_quadric_camera[k] = coarse.detections[k].shape.quadric().pose().inverse();
+    cos_angle[k] = std::cos(coarse.detections[k].shape.quadric_class == QuadricClass::kPlane
+                                ? p.planes.max_normal_angle
+                                : p.curved_max_normal_angle);
+  }
+  // Per-chunk tallies of the labelled points (rows split over threads), merged afterwards.
+  struct Tally {
+    std::vector<int> count;
+    std::vector<Eigen::Vector3d> lo, hi;
+    std::vector<ImageRoi> box;  // x, y min; width, height = max
+  };
+  const int threads = std::max(1, std::min(p.threads, height));
+  std::vector<Tally> tallies(threads);
+  const int cw = coarse.labels.cols, ch = coarse.labels.rows;
+  forEachChunk(height, threads, [&](int chunk, int v_begin, int v_end) {
+    Tally& tally = tallies[chunk];
+    tally.count.assign(n, 0);
+    tally.lo.assign(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
+    tally.hi.assign(n, Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
+    tally.box.assign(n, ImageRoi{width, height, -1, -1});
+    for (int v = v_begin; v < v_end; ++v) {
+      const int cv0 = std::min(v / d, ch - 1), cv1 = std::min(v / d + 1, ch - 1);
+      for (int u = 0; u < width; ++u) {
+        const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
+        if (!validPoint(q, p))
+          continue;
+        const int cu0 = std::min(u / d, cw - 1), cu1 = std::min(u / d + 1, cw - 1);
+        const std::uint16_t candidates[4] = {
+            coarse.labels.at<std::uint16_t>(cv0, cu0), coarse.labels.at<std::uint16_t>(cv0, cu1),
+            coarse.labels.at<std::uint16_t>(cv1, cu0), coarse.labels.at<std::uint16_t>(cv1, cu1)};
+        const Eigen::Vector3d point = pointOf(q);
+        const double threshold =
+            depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
+        int best = 0;
+        double best_distance = threshold;
+        for (int c = 0; c < 4; ++c) {
+          const int label = candidates[c];
+          // Inside a region the four samples share one label: each surface is measured once.
+          if (label == 0 || label == best || (c > 0 && label == candidates[c - 1]) ||
+              (c > 1 && label == candidates[c - 2]) || (c > 2 && label == candidates[0]))
+            continue;
+          const PrimitiveShape& shape = coarse.detections[label - 1].shape;
+          const double distance = std::abs(shape.distance(point));
+          if (distance >= best_distance)
+            continue;
+          if (std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
+            continue;
+          best = label;
+          best_distance = distance;
+        }
+        if (best == 0)
+          continue;
+        result.labels.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(best);
+        const int k = best - 1;
+        ++tally.count[k];
+        const Eigen::Vector3d local = T_quadric_camera[k] * point;
+        tally.lo[k] = tally.lo[k].cwiseMin(local);
+        tally.hi[k] = tally.hi[k].cwiseMax(local);
+        ImageRoi& box = tally.box[k];
+        box.x_offset = std::min(box.x_offset, u);
+        box.y_offset = std::min(box.y_offset, v);
+        box.width = std::max(box.width, u);
+        box.height = std::max(box.height, v);
+      }
+    }
+  });
+  std::vector<int> count(n, 0);
+  std::vector<Eigen::Vector3d> lo(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
+  std::vector<Eigen::Vector3d> hi(n,
+                                  Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
+  std::vector<ImageRoi> box(n, ImageRoi{width, height, -1, -1});
+  for (const Tally& tally : tallies) {
+    for (int k = 0; k < n; ++k) {
+      count[k] += tally.count[k];
+      lo[k] = lo[k].cwiseMin(tally.lo[k]);
+      hi[k] = hi[k].cwiseMax(tally.hi[k]);
+      box[k].x_offset = std::min(box[k].x_offset, tally.box[k].x_offset);
+      box[k].y_offset = std::min(box[k].y_offset, tally.box[k].y_offset);
+      box[k].width = std::max(box[k].width, tally.box[k].width);
+      box[k].height = std::max(box[k].height, tally.box[k].height);
+    }
+  }
+  // Keep the detections with support, renumbered 1..m.
+  std::vector<std::uint16_t> relabel(n + 1, 0);
+  for (int k = 0; k < n; ++k) {
+    if (count[k] == 0)
+      continue;
+    QuadricDetection detection = coarse.detections[k];
+    detection.label = static_cast<std::uint16_t>(result.detections.size() + 1);
+    relabel[k + 1] = detection.label;
+    // More points of the same noise: the covariance shrinks with the support.
+    detection.covariance *= static_cast<double>(detection.num_points) / count[k];
+    detection.num_points = count[k];
+    detection.extent_min = lo[k];
+    detection.extent_max = hi[k];
+    detection.roi = ImageRoi{box[k].x_offset, box[k].y_offset, box[k].width - box[k].x_offset + 1,
+                             box[k].height - box[k].y_offset + 1};
+    result.detections.push_back(std::move(detection));
+  }
+  for (int v = 0; v < height; ++v)
+    for (int u = 0; u < width; ++u) {
+      std::uint16_t& label = result.labels.at<std::uint16_t>(v, u);
+      label = relabel[label];
+    }
+  return result;
+}
+
+}  // namespace quadric_slam
