@@ -1,0 +1,115 @@
+// The segmenter's starting shapes (curved_shape_starts.h) on exact and noisy samples of the visible
+// side of a surface: a cone and a cylinder recovered from points and normals alone, a cone from a
+// cylinder fit of a cone's points, a cylinder from a thin cone, and the shape curvature.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "quadric_slam/frontend/curved_shape_starts.h"
+
+namespace qs = quadric_slam;
+using qs::PrimitiveShape;
+
+namespace {
+
+struct Samples {
+  std::vector<Eigen::Vector3d> points, normals;
+};
+
+// The camera-facing half (azimuth within +-80 degrees of the camera direction) of a cone or a
+// cylinder with axis along y at (x0, *, z0), heights y in [y_min, y_max]; normals out of the
+// surface, with optional Gaussian noise on the points.
+Samples axialSurface(bool cone, double radius_or_angle, double y_min, double y_max, double noise,
+                     unsigned seed) {
+  const Eigen::Vector3d apex(0.1, -0.3, 1.6);  // cone apex / a point on the cylinder's axis
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, noise);
+  Samples s;
+  for (int i = 0; i < 800; ++i) {
+    const double y = y_min + (y_max - y_min) * uni(rng);
+    // Azimuth measured from -z (towards the camera at the origin).
+    const double a = (uni(rng) - 0.5) * 2 * 80 * M_PI / 180;
+    const Eigen::Vector3d radial(std::sin(a), 0, -std::cos(a));
+    const double r = cone ? y * std::tan(radius_or_angle) : radius_or_angle;
+    const Eigen::Vector3d axial = Eigen::Vector3d::UnitY();
+    Eigen::Vector3d n = cone ? Eigen::Vector3d(std::cos(radius_or_angle) * radial -
+                                               std::sin(radius_or_angle) * axial)
+                             : radial;
+    s.points.push_back(apex + y * axial + r * radial + gauss(rng) * n);
+    s.normals.push_back(n.normalized());
+  }
+  return s;
+}
+
+double angleBetweenAxes(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized()))));
+}
+
+}  // namespace
+
+TEST(CurvedShapeStarts, ConeFromNormalsRecoversApexAxisAndHalfAngle) {
+  const double half_angle = 0.35;
+  const Samples s = axialSurface(true, half_angle, 0.2, 0.5, 0.0, 1);
+  const PrimitiveShape cone = qs::coneFromNormals(s.points, s.normals);
+  EXPECT_NEAR((cone.point - Eigen::Vector3d(0.1, -0.3, 1.6)).norm(), 0.0, 1e-6);
+  EXPECT_LT(angleBetweenAxes(cone.direction, Eigen::Vector3d::UnitY()), 1e-6);
+  EXPECT_GT(cone.direction.y(), 0);  // from the apex into the opening
+  EXPECT_NEAR(cone.size, half_angle, 1e-6);
+  // Too few points: degenerate (half angle 0).
+  const std::vector<Eigen::Vector3d> few(s.points.begin(), s.points.begin() + 5);
+  const std::vector<Eigen::Vector3d> few_normals(s.normals.begin(), s.normals.begin() + 5);
+  EXPECT_EQ(qs::coneFromNormals(few, few_normals).size, 0.0);
+}
+
+TEST(CurvedShapeStarts, CylinderFromNormalsRecoversAxisAndRadiusUnderNoise) {
+  const double radius = 0.06;
+  const Samples s = axialSurface(false, radius, -0.2, 0.2, 0.002, 2);
+  const PrimitiveShape cylinder = qs::cylinderFromNormals(s.points, s.normals, 1.0 / radius);
+  EXPECT_LT(angleBetweenAxes(cylinder.direction, Eigen::Vector3d::UnitY()), 0.02);
+  EXPECT_NEAR(cylinder.size, radius, 1e-12);  // the curvature given
+  // The axis passes within a few millimetres of the true one.
+  const Eigen::Vector3d v = cylinder.point - Eigen::Vector3d(0.1, -0.3, 1.6);
+  EXPECT_LT((v - v.dot(cylinder.direction) * cylinder.direction).norm(), 0.005);
+  EXPECT_EQ(qs::cylinderFromNormals(s.points, s.normals, 0.0).size, 0.0);
+}
+
+TEST(CurvedShapeStarts, ConeFromCylinderAndCylinderFromConeRoundTheAxis) {
+  const double half_angle = 0.3;
+  const Samples s = axialSurface(true, half_angle, 0.2, 0.5, 0.0, 3);
+  // A cylinder on the cone's axis: the linear radius profile gives back the cone.
+  const PrimitiveShape axis_cylinder =
+      PrimitiveShape::cylinder(Eigen::Vector3d(0.1, 0.0, 1.6), Eigen::Vector3d::UnitY(), 0.1);
+  const PrimitiveShape cone = qs::coneFromCylinder(axis_cylinder, s.points);
+  EXPECT_NEAR((cone.point - Eigen::Vector3d(0.1, -0.3, 1.6)).norm(), 0.0, 1e-6);
+  EXPECT_NEAR(cone.size, half_angle, 1e-6);
+  EXPECT_GT(cone.direction.y(), 0);
+  // The cylinder of a cone: on the same axis, with the points' mean distance to it as radius.
+  const PrimitiveShape cylinder = qs::cylinderFromCone(cone, s.points);
+  EXPECT_LT(angleBetweenAxes(cylinder.direction, Eigen::Vector3d::UnitY()), 1e-6);
+  double mean_rho = 0;
+  for (const auto& p : s.points) {
+    const Eigen::Vector3d v = p - Eigen::Vector3d(0.1, -0.3, 1.6);
+    mean_rho += (v - v.y() * Eigen::Vector3d::UnitY()).norm();
+  }
+  EXPECT_NEAR(cylinder.size, mean_rho / s.points.size(), 1e-6);
+  // A true cylinder's points have no radius slope: no cone (half angle 0).
+  const Samples c = axialSurface(false, 0.08, -0.2, 0.2, 0.0, 4);
+  EXPECT_EQ(qs::coneFromCylinder(axis_cylinder, c.points).size, 0.0);
+}
+
+TEST(CurvedShapeStarts, ShapeCurvatureIsOneOverRadiusOrTheConesMeanCurvature) {
+  const std::vector<Eigen::Vector3d> none;
+  EXPECT_DOUBLE_EQ(
+      qs::shapeCurvature(PrimitiveShape::sphere(Eigen::Vector3d(0, 0, 2), 0.25), none), 4.0);
+  EXPECT_DOUBLE_EQ(qs::shapeCurvature(PrimitiveShape::cylinder(Eigen::Vector3d(0, 0, 2),
+                                                               Eigen::Vector3d::UnitY(), 0.05),
+                                      none),
+                   20.0);
+  // A cone point at distance rho from the axis: curvature cos(half angle) / rho.
+  const PrimitiveShape cone =
+      PrimitiveShape::cone(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(), 0.4);
+  const std::vector<Eigen::Vector3d> at_rho = {Eigen::Vector3d(0.1, 0.5, 0)};
+  EXPECT_NEAR(qs::shapeCurvature(cone, at_rho), std::cos(0.4) / 0.1, 1e-12);
+}
