@@ -23,6 +23,10 @@ QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) 
 
 namespace {
 
+// Distance gate, in RMS of a detection's fit, within which a pixel inside a single surface's
+// samples joins it without normal agreement (the 3-sigma band of the fit's own residuals).
+constexpr double kNoiseGate = 3.0;
+
 bool validPoint(const pcl::PointNormal& q, const QuadricSegmenter::Params& p) {
   return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
          std::isfinite(q.normal_x) && std::isfinite(q.normal_y) && std::isfinite(q.normal_z) &&
@@ -39,12 +43,13 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
   result.labels = cv::Mat::zeros(height, width, CV_16UC1);
   const int n = static_cast<int>(coarse.detections.size());
   std::vector<Eigen::Isometry3d> T_quadric_camera(n);
-  std::vector<double> cos_angle(n);
+  std::vector<double> cos_angle(n), noise_gate(n);
   for (int k = 0; k < n; ++k) {
     T_quadric_camera[k] = coarse.detections[k].shape.quadric().pose().inverse();
     cos_angle[k] = std::cos(coarse.detections[k].shape.quadric_class == QuadricClass::kPlane
                                 ? p.planes.max_normal_angle
                                 : p.curved_max_normal_angle);
+    noise_gate[k] = std::max(1e-3, kNoiseGate * coarse.detections[k].fit_rms);
   }
   // Per-chunk tallies of the labelled points (rows split over threads), merged afterwards.
   struct Tally {
@@ -74,6 +79,20 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
         const Eigen::Vector3d point = pointOf(q);
         const double threshold =
             depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
+        // Where the neighbouring samples name a single surface (the others unlabelled), the pixel
+        // need not have an agreeing normal when it fits the surface as well as the surface's own
+        // points do (within kNoiseGate x the fit's RMS): its normal is the noisiest evidence
+        // there (at 3-4 m the normals of a flat wall scatter beyond the normal tolerance, which
+        // left holes all over far surfaces). Other pixels, and all between two labelled
+        // surfaces, need the normal to agree as well.
+        std::uint16_t only = 0;
+        bool single_surface = true;
+        for (const std::uint16_t label : candidates) {
+          if (label == 0 || label == only)
+            continue;
+          single_surface = only == 0;
+          only = label;
+        }
         int best = 0;
         double best_distance = threshold;
         for (int c = 0; c < 4; ++c) {
@@ -86,7 +105,8 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
           const double distance = std::abs(shape.distance(point));
           if (distance >= best_distance)
             continue;
-          if (std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
+          if ((!single_surface || distance > noise_gate[label - 1]) &&
+              std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
             continue;
           best = label;
           best_distance = distance;

@@ -14,8 +14,9 @@ QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d);
 
 // Full-resolution labels from a segmentation of the grid decimated by d: each valid pixel takes
 // the label of a neighbouring coarse sample whose surface it fits (distance threshold and normal
-// agreement, as on the coarse grid); support, ROI, extent and covariance follow the full-resolution
-// points.
+// agreement, as on the coarse grid; no normal needed within 3 x the fit's RMS of a surface that is
+// the only one among the neighbouring samples);
+// support, ROI, extent and covariance follow the full-resolution points.
 Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
                       const QuadricSegmenter::Params& p);
 
