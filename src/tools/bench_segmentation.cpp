@@ -1,10 +1,11 @@
 // bench_segmentation: time of QuadricSegmenter per 640x480 frame (normals excluded) over the real
 // frames in ../shared/data (OSD mosd_cylinders PCDs, TUM depth PNGs), every K-th frame of the real
-// 7-Scenes kitchen sequence, and rendered synthetic frames, against the baseline the paper uses:
+// 7-Scenes kitchen sequence, frames of the generated desk and room scenes with the harsh Kinect
+// model, and simple rendered synthetic frames, against the baseline the paper uses:
 // CGAL Efficient RANSAC with plane, sphere, cylinder and cone on all points of the full frame.
 //
 //   bench_segmentation [--data DIR] [--repeats N (3)] [--synthetic N (10)] [--baseline-frames N
-//   (8)] [--kitchen-every K (50; 0: no kitchen frames)]
+//   (8)] [--kitchen-every K (50; 0: no kitchen frames)] [--harsh N (10 per scene; 0: none)]
 //
 // Prints median and p95 per set and per stage, plane and curved segments per frame per set, the
 // baseline's time, their ratio, and the machine load (uptime).
@@ -26,6 +27,8 @@
 #include "quadric_slam/io/segmentation_input.h"
 #include "quadric_slam/pipeline/segmenter_params.h"
 #include "quadric_slam/io/frame_source.h"
+#include "quadric_slam/sim/scene_yaml.h"
+#include "quadric_slam/sim/synthetic_frame_source.h"
 
 namespace qs = quadric_slam;
 namespace fs = std::filesystem;
@@ -122,6 +125,30 @@ std::vector<Frame> kitchenFrames(const std::string& data, int every,
   return frames;
 }
 
+// Frames of the generated scenes with the harsh Kinect depth model (sim/kinect_depth_model.h, the
+// generator's default): `count` frames at 1 Hz of each scene's seeded hand-held motion.
+std::vector<Frame> harshFrames(const std::vector<std::string>& scenes, int count,
+                               const qs::NormalEstimator& normals) {
+  std::vector<Frame> frames;
+  for (const std::string& path : scenes) {
+    if (count <= 0)
+      break;
+    qs::SyntheticFrameSource::Params params;
+    params.seconds = count;
+    params.rate = 1.0;
+    params.rgb = false;
+    qs::SyntheticFrameSource source(qs::readSceneYaml(path), params);
+    qs::RgbdFrame frame;
+    while (source.next(frame)) {
+      const qs::DepthImageView<float> view = qs::depthViewOf(frame.depth_m);
+      frames.push_back({fs::path(path).stem().string() + "_" + std::to_string(frames.size()),
+                        normals.compute(qs::backProject(view, frame.intrinsics,
+                                                        qs::BackProjectionParams()))});
+    }
+  }
+  return frames;
+}
+
 // Desk-like rendered scenes: floor, wall, and a sphere, cylinder and cone at random places.
 std::vector<Frame> syntheticFrames(int count, const qs::NormalEstimator& normals) {
   std::vector<Frame> frames;
@@ -192,7 +219,7 @@ void report(const char* name, const std::vector<double>& times) {
 
 int main(int argc, char** argv) {
   std::string data = QUADRIC_SLAM_SHARED_DATA_DIR;
-  int repeats = 3, synthetic = 10, baseline_frames = 8, kitchen_every = 50;
+  int repeats = 3, synthetic = 10, baseline_frames = 8, kitchen_every = 50, harsh = 10;
   qs::QuadricSegmenter::Params params;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i], value = argv[i + 1];
@@ -204,6 +231,8 @@ int main(int argc, char** argv) {
       synthetic = std::atoi(value.c_str());
     else if (arg == "--baseline-frames")
       baseline_frames = std::atoi(value.c_str());
+    else if (arg == "--harsh")
+      harsh = std::atoi(value.c_str());
     else if (arg == "--kitchen-every")
       kitchen_every = std::atoi(value.c_str());
     else if (arg == "--config")
@@ -214,7 +243,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: bench_segmentation [--data DIR] [--repeats N] [--synthetic N] "
-                   "[--baseline-frames N] [--kitchen-every K] [--config segmentation.yaml] [--set KEY=VALUE]...\n");
+                   "[--baseline-frames N] [--kitchen-every K] [--harsh N] [--config segmentation.yaml] [--set KEY=VALUE]...\n");
       return 2;
     }
   }
@@ -223,24 +252,37 @@ int main(int argc, char** argv) {
   const std::vector<Frame> real = realFrames(data, normals);
   const std::vector<Frame> kitchen = kitchenFrames(data, kitchen_every, normals);
   const std::vector<Frame> synth = syntheticFrames(synthetic, normals);
-  std::printf("frames: %zu real (%s), %zu kitchen (every %d-th), %zu synthetic; %d repeats each\n",
-              real.size(), data.c_str(), kitchen.size(), kitchen_every, synth.size(), repeats);
+  const std::string scenes = std::string(QUADRIC_SLAM_CONFIG_DIR) + "/scenes/";
+  const std::vector<Frame> harsh_frames =
+      harshFrames({scenes + "desk.yaml", scenes + "room.yaml"}, harsh, normals);
+  std::printf(
+      "frames: %zu real (%s), %zu kitchen (every %d-th), %zu harsh-model (desk, room), %zu "
+      "synthetic; %d repeats each\n",
+      real.size(), data.c_str(), kitchen.size(), kitchen_every, harsh_frames.size(), synth.size(),
+      repeats);
 
   // Segments per frame, per set: planes and curved (sphere, cylinder, cone, general).
   struct Counts {
     double frames = 0, planes = 0, curved = 0, ransac_points = 0, candidates = 0;
   };
-  Counts real_counts, kitchen_counts, synth_counts;
-  std::vector<double> real_ms, kitchen_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms, upsample_ms,
+  Counts real_counts, kitchen_counts, harsh_counts, synth_counts;
+  std::vector<double> real_ms, kitchen_ms, harsh_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms, upsample_ms,
       boundary_ms;
   for (int r = 0; r < repeats; ++r) {
-    for (const auto* set : {&real, &kitchen, &synth}) {
+    for (const auto* set : {&real, &kitchen, &harsh_frames, &synth}) {
       for (const Frame& f : *set) {
         const auto t0 = Clock::now();
         const qs::Segmentation s = segmenter.segment(f.cloud);
         const double t = ms(t0, Clock::now());
-        (set == &real ? real_ms : set == &kitchen ? kitchen_ms : synth_ms).push_back(t);
-        Counts& counts = set == &real ? real_counts : set == &kitchen ? kitchen_counts : synth_counts;
+        (set == &real      ? real_ms
+         : set == &kitchen ? kitchen_ms
+         : set == &synth   ? synth_ms
+                           : harsh_ms)
+            .push_back(t);
+        Counts& counts = set == &real      ? real_counts
+                         : set == &kitchen ? kitchen_counts
+                         : set == &synth   ? synth_counts
+                                           : harsh_counts;
         counts.frames += 1;
         counts.ransac_points += s.timings.ransac_points;
         counts.candidates += s.timings.ransac_candidates;
@@ -258,11 +300,13 @@ int main(int argc, char** argv) {
   std::vector<double> base_ms;
   std::size_t base_shapes = 0;
   const std::size_t step = std::max<std::size_t>(
-      1, (real.size() + kitchen.size() + synth.size()) / std::max(1, baseline_frames));
+      1, (real.size() + kitchen.size() + harsh_frames.size() + synth.size()) / std::max(1, baseline_frames));
   std::vector<const Frame*> everything;
   for (const auto& f : real)
     everything.push_back(&f);
   for (const auto& f : kitchen)
+    everything.push_back(&f);
+  for (const auto& f : harsh_frames)
     everything.push_back(&f);
   for (const auto& f : synth)
     everything.push_back(&f);
@@ -276,6 +320,7 @@ int main(int argc, char** argv) {
   std::printf("QuadricSegmenter (normals excluded):\n");
   report("  real frames", real_ms);
   report("  kitchen frames", kitchen_ms);
+  report("  harsh-model frames", harsh_ms);
   report("  synthetic frames", synth_ms);
   report("  all frames", all_ms);
   report("    stage: planes", planes_ms);
@@ -284,7 +329,8 @@ int main(int argc, char** argv) {
   report("    stage: upsampling", upsample_ms);
   report("    stage: boundary", boundary_ms);
   for (const auto& [name, c] : {std::pair<const char*, Counts>{"real", real_counts},
-                                {"kitchen", kitchen_counts}, {"synthetic", synth_counts}})
+                                {"kitchen", kitchen_counts}, {"harsh", harsh_counts},
+                                {"synthetic", synth_counts}})
     if (c.frames > 0)
       std::printf("  per frame, %-9s  segments: planes %5.1f  curved %5.1f;  RANSAC input %6.0f "
                   "points, %5.1f candidates\n",
