@@ -66,20 +66,18 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
     tally.lo.assign(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
     tally.hi.assign(n, Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
     tally.box.assign(n, ImageRoi{width, height, -1, -1});
+    const int blocks = (width + d - 1) / d;
     for (int v = v_begin; v < v_end; ++v) {
       const int cv0 = std::min(v / d, ch - 1), cv1 = std::min(v / d + 1, ch - 1);
-      for (int u = 0; u < width; ++u) {
-        const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
-        if (!validPoint(q, p))
+      const std::uint16_t* row0 = coarse.labels.ptr<std::uint16_t>(cv0);
+      const std::uint16_t* row1 = coarse.labels.ptr<std::uint16_t>(cv1);
+      // The d pixels of a row in one block share their four neighbouring coarse samples.
+      for (int b = 0; b < blocks; ++b) {
+        const int cu0 = std::min(b, cw - 1), cu1 = std::min(b + 1, cw - 1);
+        const std::uint16_t candidates[4] = {row0[cu0], row0[cu1], row1[cu0], row1[cu1]};
+        if ((candidates[0] | candidates[1] | candidates[2] | candidates[3]) == 0)
           continue;
-        const int cu0 = std::min(u / d, cw - 1), cu1 = std::min(u / d + 1, cw - 1);
-        const std::uint16_t candidates[4] = {
-            coarse.labels.at<std::uint16_t>(cv0, cu0), coarse.labels.at<std::uint16_t>(cv0, cu1),
-            coarse.labels.at<std::uint16_t>(cv1, cu0), coarse.labels.at<std::uint16_t>(cv1, cu1)};
-        const Eigen::Vector3d point = pointOf(q);
-        const double threshold =
-            depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
-        // Where the neighbouring samples name a single surface (the others unlabelled), the pixel
+        // Where the neighbouring samples name a single surface (the others unlabelled), a pixel
         // need not have an agreeing normal when it fits the surface as well as the surface's own
         // points do (within kNoiseGate x the fit's RMS): its normal is the noisiest evidence
         // there (at 3-4 m the normals of a flat wall scatter beyond the normal tolerance, which
@@ -93,37 +91,46 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
           single_surface = only == 0;
           only = label;
         }
-        int best = 0;
-        double best_distance = threshold;
-        for (int c = 0; c < 4; ++c) {
-          const int label = candidates[c];
-          // Inside a region the four samples share one label: each surface is measured once.
-          if (label == 0 || label == best || (c > 0 && label == candidates[c - 1]) ||
-              (c > 1 && label == candidates[c - 2]) || (c > 2 && label == candidates[0]))
+        // Each surface measured once per pixel.
+        std::uint16_t labels[4];
+        int distinct = 0;
+        for (const std::uint16_t label : candidates)
+          if (label != 0 && std::find(labels, labels + distinct, label) == labels + distinct)
+            labels[distinct++] = label;
+        for (int u = b * d; u < std::min(width, (b + 1) * d); ++u) {
+          const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
+          if (!validPoint(q, p))
             continue;
-          const PrimitiveShape& shape = coarse.detections[label - 1].shape;
-          const double distance = std::abs(shape.distance(point));
-          if (distance >= best_distance)
+          const Eigen::Vector3d point = pointOf(q);
+          int best = 0;
+          double best_distance =
+              depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
+          for (int c = 0; c < distinct; ++c) {
+            const int label = labels[c];
+            const PrimitiveShape& shape = coarse.detections[label - 1].shape;
+            const double distance = std::abs(shape.distance(point));
+            if (distance >= best_distance)
+              continue;
+            if ((!single_surface || distance > noise_gate[label - 1]) &&
+                std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
+              continue;
+            best = label;
+            best_distance = distance;
+          }
+          if (best == 0)
             continue;
-          if ((!single_surface || distance > noise_gate[label - 1]) &&
-              std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
-            continue;
-          best = label;
-          best_distance = distance;
+          result.labels.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(best);
+          const int k = best - 1;
+          ++tally.count[k];
+          const Eigen::Vector3d local = T_quadric_camera[k] * point;
+          tally.lo[k] = tally.lo[k].cwiseMin(local);
+          tally.hi[k] = tally.hi[k].cwiseMax(local);
+          ImageRoi& box = tally.box[k];
+          box.x_offset = std::min(box.x_offset, u);
+          box.y_offset = std::min(box.y_offset, v);
+          box.width = std::max(box.width, u);
+          box.height = std::max(box.height, v);
         }
-        if (best == 0)
-          continue;
-        result.labels.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(best);
-        const int k = best - 1;
-        ++tally.count[k];
-        const Eigen::Vector3d local = T_quadric_camera[k] * point;
-        tally.lo[k] = tally.lo[k].cwiseMin(local);
-        tally.hi[k] = tally.hi[k].cwiseMax(local);
-        ImageRoi& box = tally.box[k];
-        box.x_offset = std::min(box.x_offset, u);
-        box.y_offset = std::min(box.y_offset, v);
-        box.width = std::max(box.width, u);
-        box.height = std::max(box.height, v);
       }
     }
   });

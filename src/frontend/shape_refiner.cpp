@@ -218,9 +218,13 @@ Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
   const PrimitiveShape base = PrimitiveShape::fromQuadric(quadric);
   const Eigen::Matrix<double, 7, Eigen::Dynamic> D = shapeParameterJacobian(quadric);
   const int k = static_cast<int>(D.cols());
-  Eigen::MatrixXd J(points.size(), k);
+  // Per-point gradients as the rows of G, then one product (a row-by-row product would make a
+  // temporary per point).
+  Eigen::Matrix<double, Eigen::Dynamic, 7> G(points.size(), 7);
   for (std::size_t i = 0; i < points.size(); ++i)
-    J.row(static_cast<Eigen::Index>(i)) = base.distanceGradient(points[i]).transpose() * D;
+    G.row(static_cast<Eigen::Index>(i)) = base.distanceGradient(points[i]).transpose();
+  Eigen::MatrixXd J(points.size(), k);
+  J.noalias() = G * D;
   return J;
 }
 
