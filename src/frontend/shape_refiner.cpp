@@ -102,6 +102,32 @@ std::vector<Eigen::Vector3d> subsample(const std::vector<Eigen::Vector3d>& all_p
   return points;
 }
 
+// J^T J and J^T r for the distances' Jacobian J (distanceJacobian), accumulated point by point
+// without storing J (the refinement needs nothing else).
+void normalEquations(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points,
+                     const Eigen::VectorXd& r, Eigen::MatrixXd& H, Eigen::VectorXd& g) {
+  if (shape.quadric_class == QuadricClass::kGeneral) {
+    const Eigen::MatrixXd J = distanceJacobian(shape, points);
+    H = J.transpose() * J;
+    g = J.transpose() * r;
+    return;
+  }
+  // J = G D with G the per-point gradients in (point, direction, size): accumulate the fixed-size
+  // G^T G and G^T r, then H = D^T (G^T G) D and g = D^T (G^T r).
+  const QuadricModel quadric = shape.quadric();
+  const PrimitiveShape base = PrimitiveShape::fromQuadric(quadric);
+  const Eigen::Matrix<double, 7, Eigen::Dynamic> D = shapeParameterJacobian(quadric);
+  Eigen::Matrix<double, 7, 7> GG = Eigen::Matrix<double, 7, 7>::Zero();
+  Eigen::Matrix<double, 7, 1> Gr = Eigen::Matrix<double, 7, 1>::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Matrix<double, 7, 1> gradient = base.distanceGradient(points[i]);
+    GG.noalias() += gradient * gradient.transpose();
+    Gr.noalias() += gradient * r[static_cast<Eigen::Index>(i)];
+  }
+  H = D.transpose() * GG * D;
+  g = D.transpose() * Gr;
+}
+
 // Covariance of the fit: sigma^2 (J^T J)^-1, J over all points (the sub-sample's normal matrix
 // scaled by N / n), sigma^2 the residual variance.
 ShapeRefiner::Result covarianceOf(const PrimitiveShape& shape,
@@ -110,8 +136,9 @@ ShapeRefiner::Result covarianceOf(const PrimitiveShape& shape,
   ShapeRefiner::Result result;
   const int k = minimalDimension(shape.quadric_class);
   const double cost = residuals(shape, points).squaredNorm();
-  const Eigen::MatrixXd J = distanceJacobian(shape, points);
-  Eigen::MatrixXd H = J.transpose() * J;
+  Eigen::MatrixXd H;
+  Eigen::VectorXd unused;
+  normalEquations(shape, points, Eigen::VectorXd::Zero(points.size()), H, unused);
   H *= static_cast<double>(all_points) / static_cast<double>(points.size());
   const double sigma2 = cost / (static_cast<double>(points.size()) - k);
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H);
@@ -155,9 +182,9 @@ ShapeRefiner::Result ShapeRefiner::refineUnchecked(
   double cost = r.squaredNorm();
   double lambda = 1e-4;
   for (int it = 0; it < params_.max_iterations; ++it) {
-    const Eigen::MatrixXd J = distanceJacobian(shape, points);
-    const Eigen::MatrixXd H = J.transpose() * J;
-    const Eigen::VectorXd g = J.transpose() * r;
+    Eigen::MatrixXd H;
+    Eigen::VectorXd g;
+    normalEquations(shape, points, r, H, g);
     bool improved = false;
     for (int attempt = 0; attempt < 10 && !improved; ++attempt) {
       Eigen::MatrixXd A = H;
@@ -218,13 +245,13 @@ Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
   const PrimitiveShape base = PrimitiveShape::fromQuadric(quadric);
   const Eigen::Matrix<double, 7, Eigen::Dynamic> D = shapeParameterJacobian(quadric);
   const int k = static_cast<int>(D.cols());
-  // Per-point gradients as the rows of G, then one product (a row-by-row product would make a
-  // temporary per point).
-  Eigen::Matrix<double, Eigen::Dynamic, 7> G(points.size(), 7);
-  for (std::size_t i = 0; i < points.size(); ++i)
-    G.row(static_cast<Eigen::Index>(i)) = base.distanceGradient(points[i]).transpose();
+  // D at most 7 x 7 on the stack: the per-row product needs no temporary on the heap (and a
+  // general matrix product of n x 7 by 7 x k costs more in packing than it saves).
+  const Eigen::Matrix<double, 7, Eigen::Dynamic, 0, 7, 7> D_small = D;
   Eigen::MatrixXd J(points.size(), k);
-  J.noalias() = G * D;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    J.row(static_cast<Eigen::Index>(i)).noalias() =
+        base.distanceGradient(points[i]).transpose().lazyProduct(D_small);
   return J;
 }
 
