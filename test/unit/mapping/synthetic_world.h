@@ -263,6 +263,27 @@ inline TrueLandmark wallPiece(double y0, double y1, double z0 = 0.0, double z1 =
                Eigen::Vector3d::UnitY(), 0.5 * (y1 - y0), 0.5 * (z1 - z0));
 }
 
+// A wall seen in three parts, frame by frame, with the floor (z = 0, 3 x 4 m around x = 1.5) in
+// every frame: its left part (y in [-3.5, -2]) in the first 12 frames, its right part ([2, 3.5])
+// in the next 12, then its middle ([-2.2, 2.2]), which makes the parts' extents touch. The parts
+// are 4 m apart: synthetic measurements come in frames turned at random about the normal, whose
+// axis-aligned boxes (moved twice, into the candidate's and the landmark's frame) are up to twice
+// as wide, and association grows boxes by 0.25 m.
+inline std::vector<std::vector<TrueLandmark>> wallInThreeParts(int frames = 36) {
+  const TrueLandmark floor = plane(Eigen::Vector3d(1.5, 0, 0), Eigen::Vector3d::UnitZ(),
+                                   Eigen::Vector3d::UnitX(), 1.5, 2.0);
+  std::vector<std::vector<TrueLandmark>> pieces;
+  for (int i = 0; i < frames; ++i) {
+    if (i < frames / 3)
+      pieces.push_back({wallPiece(-3.5, -2.0, 0.5, 2.0), floor});
+    else if (i < 2 * frames / 3)
+      pieces.push_back({wallPiece(2.0, 3.5, 0.5, 2.0), floor});
+    else
+      pieces.push_back({wallPiece(-2.2, 2.2, 0.5, 2.0), floor});
+  }
+  return pieces;
+}
+
 // The camera 3 m from the wall of wallPiece at 1.3 m height, looking at it (+x) and a little down,
 // sliding along y from y_from to y_to over `frames` frames.
 inline std::vector<Eigen::Isometry3d> slideAlongWall(int frames, double y_from, double y_to) {

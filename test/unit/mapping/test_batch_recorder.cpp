@@ -33,17 +33,7 @@ std::map<int, int> observationsPerLandmark(const BatchRecorder& recorder) {
 // odometry: a drift would tell the two parts apart). `following` records every result as it is;
 // `ignoring` records the same results with their merges taken out.
 TEST(BatchRecorder, ObservationsOfAMergedLandmarkGoToItsSurvivor) {
-  const test::TrueLandmark floor =
-      test::plane(Eigen::Vector3d(1.5, 0, 0), kUnitZ, kUnitX, 1.5, 2.0);
-  std::vector<std::vector<test::TrueLandmark>> pieces;
-  for (int i = 0; i < 36; ++i) {
-    if (i < 12)
-      pieces.push_back({test::wallPiece(-3.5, -2.0, 0.5, 2.0), floor});
-    else if (i < 24)
-      pieces.push_back({test::wallPiece(2.0, 3.5, 0.5, 2.0), floor});
-    else
-      pieces.push_back({test::wallPiece(-2.2, 2.2, 0.5, 2.0), floor});
-  }
+  const std::vector<std::vector<test::TrueLandmark>> pieces = test::wallInThreeParts(36);
   const std::vector<Eigen::Isometry3d> poses = test::slideAlongWall(36, -0.3, 0.3);
   std::mt19937 rng(63);
   QuadricMapper::Params params;

@@ -605,20 +605,7 @@ TEST(QuadricMapper, TwoTablesAtOneHeightTwoMetresApartStayTwoLandmarks) {
 // reported in the frame's result and in the map's record, and the merged landmark's
 // reconstruction points move to the survivor.
 TEST(QuadricMapper, LandmarksFoundToBeOneSurfaceAreMergedAndReported) {
-  const test::TrueLandmark floor =
-      test::plane(Eigen::Vector3d(1.5, 0, 0), kUnitZ, kUnitX, 1.5, 2.0);
-  // The parts are 4 m apart: the synthetic measurements come in frames turned at random about the
-  // normal, whose axis-aligned boxes (moved twice, into the candidate's and the landmark's frame)
-  // are up to twice as wide, and association grows boxes by 0.25 m.
-  std::vector<std::vector<test::TrueLandmark>> pieces;
-  for (int i = 0; i < 36; ++i) {
-    if (i < 12)
-      pieces.push_back({test::wallPiece(-3.5, -2.0, 0.5, 2.0), floor});
-    else if (i < 24)
-      pieces.push_back({test::wallPiece(2.0, 3.5, 0.5, 2.0), floor});
-    else
-      pieces.push_back({test::wallPiece(-2.2, 2.2, 0.5, 2.0), floor});
-  }
+  const std::vector<std::vector<test::TrueLandmark>> pieces = test::wallInThreeParts(36);
   QuadricMapper mapper;
   // Exact odometry: the two parts are estimated from different frames, and a drift the walls and
   // the floor cannot observe (yaw, sliding along the wall) would tell them apart.
