@@ -9,6 +9,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/core.hpp>
 #include <stdexcept>
 #include <vector>
@@ -125,6 +126,11 @@ TEST(MeasurementModelError, CornerFragmentOfABentWallMergesWithTheWall) {
   EXPECT_FALSE(without.within_gate) << "fit covariance only: d2 " << without.squared_distance;
   const LandmarkMerger::Comparison with = merger.compare(
       landmarkOf(1, withModelError(raw.wall), 600), landmarkOf(2, withModelError(raw.corner), 5));
+  std::printf(
+      "[ info     ] corner fragment %.2f deg off the wall: d2 %.1f without, %.1f with the "
+      "model error (gate %.1f)\n",
+      angle * 180 / M_PI, without.squared_distance, with.squared_distance,
+      merger.gate(QuadricClass::kPlane));
   EXPECT_TRUE(with.sameSurface()) << "d2 " << with.squared_distance << " gate "
                                   << merger.gate(QuadricClass::kPlane) << ", normals "
                                   << angle * 180 / M_PI << " deg apart";
@@ -143,6 +149,8 @@ TEST(MeasurementModelError, TwoPlanesFiveDegreesApartThatTouchStayTwo) {
   const QuadricMeasurement b = withModelError(measure(depth, cv::Rect(320, 40, 280, 400)));
   const LandmarkMerger merger;
   const LandmarkMerger::Comparison c = merger.compare(landmarkOf(1, a, 20), landmarkOf(2, b, 20));
+  std::printf("[ info     ] planes 5 deg apart: d2 %.1f with the model error (gate %.1f)\n",
+              c.squared_distance, merger.gate(QuadricClass::kPlane));
   EXPECT_TRUE(c.extents_touch);
   EXPECT_FALSE(c.within_gate) << "d2 " << c.squared_distance;
 }
