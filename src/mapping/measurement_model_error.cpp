@@ -7,8 +7,6 @@
 #include <string>
 
 #include "quadric_slam/geometry/quadric_class.h"
-#include "quadric_slam/geometry/quadric_classes.h"
-#include "quadric_slam/geometry/symmetry.h"
 
 namespace quadric_slam {
 
@@ -59,37 +57,9 @@ Eigen::MatrixXd MeasurementModelError::covariance(const QuadricMeasurement& meas
   const double n = static_cast<double>(measurement.num_points);
   const double z = supportDepth(measurement);
   const double sigma_z = params.sigma * z * z;
-  // (J^T J / n)^-1 = C_fit n / rms^2, about the quadric's origin; moved to the support's centre
-  // where a symmetry allows (a plane's origin slides in the plane, a cylinder's along its axis), so
-  // that its rotation entries are tilts about the support rather than about a far-away origin.
-  const QuadricClass quadric_class = measurement.quadric_camera.quadricClass();
-  const Eigen::Vector3d centre = 0.5 * (measurement.extent_min + measurement.extent_max);
-  Eigen::Isometry3d G = Eigen::Isometry3d::Identity();
-  if (quadric_class == QuadricClass::kPlane && centre.allFinite())
-    G.translation() = Eigen::Vector3d(0.0, centre.y(), centre.z());  // normal = quadric x
-  else if (quadric_class == QuadricClass::kCylinder && centre.allFinite())
-    G.translation() = Eigen::Vector3d(0.0, 0.0, centre.z());  // axis = quadric z
-  const Eigen::MatrixXd to_centre = minimalAdjoint(quadric_class, G.inverse());
-  Eigen::MatrixXd geometry = to_centre * fit * to_centre.transpose() * (n / (rms * rms));
-  // A support narrower than a correlation cell sees a smooth error: an offset and the error's
-  // slope, about sigma / L, not the sigma / width tilt that white noise over it would give. Its
-  // rotation entries are scaled to those of a support one cell wide.
-  Eigen::Vector3d sides = (measurement.extent_max - measurement.extent_min).cwiseAbs();
-  std::sort(sides.data(), sides.data() + 3, std::greater<double>());
-  const double cell = params.correlation_angle * z;
-  const double narrow = sides.allFinite() ? std::min(1.0, sides[1] / cell) : 1.0;
-  const QuadricClassDefinition& definition = classDefinition(quadric_class);
-  Eigen::VectorXd scale = Eigen::VectorXd::Ones(k);
-  for (int j = 0; j < k; ++j) {
-    int row = 0;
-    definition.basis.col(j).cwiseAbs().maxCoeff(&row);
-    if (row >= 3 && row < 6)  // a rotation entry (minimal columns: translation, rotation, scale)
-      scale[j] = narrow;
-  }
-  geometry = scale.asDiagonal() * geometry * scale.asDiagonal();
-  const Eigen::MatrixXd from_centre = minimalAdjoint(quadric_class, G);
-  Eigen::MatrixXd model = from_centre * geometry * from_centre.transpose() *
-                          (sigma_z * sigma_z / independentCells(measurement, params));
+  // (J^T J / n)^-1 = C_fit n / rms^2.
+  const Eigen::MatrixXd geometry = fit * (n / (rms * rms));
+  Eigen::MatrixXd model = geometry * (sigma_z * sigma_z / independentCells(measurement, params));
   return 0.5 * (model + model.transpose());
 }
 

@@ -18,10 +18,7 @@
 // independent cells, and the fit's parameters pick up the covariance
 //   C_model = sigma(z)^2 (J^T J / n)^-1 / n_eff,
 // the least-squares covariance of n_eff independent samples of that noise spread over the same
-// support. A support narrower than one cell (its smaller side w < L(z)) sees a smooth error, an
-// offset and a slope of about sigma / L, not the sigma / w tilt of white noise: there the rotation
-// entries (taken about the support's centre, where the class's symmetry lets the frame move) are
-// scaled by w / L. The geometry (J^T J / n)^-1 is recovered from the fit's own covariance,
+// support. The geometry (J^T J / n)^-1 is recovered from the fit's own covariance,
 // C_fit = rms^2 (J^T J)^-1, as C_fit n / rms^2, so every class is handled alike without the
 // supporting points. The measurement's covariance becomes C_fit + C_model.
 //
