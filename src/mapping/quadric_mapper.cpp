@@ -37,6 +37,7 @@ double rotationAngle(const Eigen::Isometry3d& T) {
 void QuadricMapper::Params::validate() const {
   map.validate();
   window.validate();
+  model_error.validate();
   requireRange(keyframe_translation > 0.0, "keyframe_translation", "(0, inf) m");
   requireRange(keyframe_rotation > 0.0, "keyframe_rotation", "(0, inf) rad");
   requireRange(keyframe_min_new_landmarks >= 1, "keyframe_min_new_landmarks", "[1, inf)");
@@ -151,6 +152,7 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
       // The mapper keeps measurements in candidates and window keyframes; their supporting
       // points are the reconstruction's business, not the estimator's, so they stay out.
       valid.push_back(measurement);
+      MeasurementModelError::add(valid.back(), params_.model_error);
       valid.back().support_points.clear();
       valid.back().support_points.shrink_to_fit();
       valid.back().support_colours.clear();

@@ -104,6 +104,8 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
   readParam(reader, "odometry_rotation_sigma", mapper.odometry_rotation_sigma, log);
   readParam(reader, "odometry_rotation_fraction", mapper.odometry_rotation_fraction, log);
   readParam(reader, "odometry_rotation_per_metre", mapper.odometry_rotation_per_metre, log);
+  readParam(reader, "model_error_sigma", mapper.model_error.sigma, log);
+  readParam(reader, "model_error_correlation_angle", mapper.model_error.correlation_angle, log);
   readParam(reader, "reconstruction_voxel_size", reconstruction.voxel_size, log);
   readParam(reader, "reconstruction_max_points_per_landmark",
             reconstruction.max_points_per_landmark, log);

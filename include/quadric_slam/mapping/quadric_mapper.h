@@ -48,6 +48,7 @@
 
 #include "quadric_slam/geometry/se3.h"
 #include "quadric_slam/mapping/landmark_registry.h"
+#include "quadric_slam/mapping/measurement_model_error.h"
 #include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/mapping/window.h"
 #include "quadric_slam/types/observation.h"
@@ -104,6 +105,10 @@ class QuadricMapper {
     double odometry_rotation_sigma = 0.002;
     double odometry_rotation_fraction = 0.05;
     double odometry_rotation_per_metre = 0.02;
+    // The depth camera's systematic error added to every measurement's covariance as it enters
+    // the mapper (mapping/measurement_model_error.h), so that the association gate, the window's
+    // weights and the merger see what a fragment of a surface really tells.
+    MeasurementModelError::Params model_error;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;

@@ -129,6 +129,27 @@ TEST(PipelineParams, MappingYamlKeysAreAllRead) {
   EXPECT_EQ(batch.compute_covariance, file["batch_compute_covariance"].as<bool>());
 }
 
+// The measurement model error (mapping/measurement_model_error.h): the file's values reach the
+// mapper, and a value out of range is refused naming the key's field.
+TEST(PipelineParams, ModelErrorKeysAreReadAndValidated) {
+  const YAML::Node file = YAML::LoadFile(kConfigDir + "mapping.yaml");
+  qs::QuadricMapper::Params mapper;
+  qs::QuadricReconstruction::Params reconstruction;
+  qs::ParamLog log;
+  qs::readMappingParams(qs::YamlParamReader(file), mapper, reconstruction, log);
+  EXPECT_DOUBLE_EQ(mapper.model_error.sigma, file["model_error_sigma"].as<double>());
+  EXPECT_DOUBLE_EQ(mapper.model_error.correlation_angle,
+                   file["model_error_correlation_angle"].as<double>());
+  for (const char* bad : {"{model_error_sigma: -0.001}", "{model_error_correlation_angle: 0}"}) {
+    try {
+      qs::readMappingParams(qs::YamlParamReader(YAML::Load(bad)), mapper, reconstruction, log);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("MeasurementModelError"), std::string::npos) << e.what();
+    }
+  }
+}
+
 // Off unless a file turns it on; a bad iteration count is refused naming the field.
 TEST(PipelineParams, BatchRefinementKeysAreValidated) {
   bool enabled = false;
