@@ -35,7 +35,8 @@ namespace quadric_slam {
 struct MeasurementModelError {
   struct Params {
     // sigma: 1-sigma systematic depth error at 1 m depth (m, [0, 0.1]; 0 disables the term).
-    double sigma = 0.002;
+    // Default 0 (off): 0.002 is the calibrated value (config/mapping.yaml), not yet the default.
+    double sigma = 0.0;
     // theta: angle over which that error is correlated, seen from the camera (rad, (0, 1.5]).
     double correlation_angle = 0.2;
 

@@ -90,8 +90,15 @@ QuadricLandmark landmarkOf(int id, const QuadricMeasurement& m, int observations
   return l;
 }
 
+// The calibrated model error (config/mapping.yaml; the term is off by default).
+MeasurementModelError::Params calibrated() {
+  MeasurementModelError::Params p;
+  p.sigma = 0.002;
+  return p;
+}
+
 QuadricMeasurement withModelError(QuadricMeasurement m) {
-  MeasurementModelError::add(m, MeasurementModelError::Params{});
+  MeasurementModelError::add(m, calibrated());
   return m;
 }
 
@@ -157,7 +164,7 @@ TEST(MeasurementModelError, TwoPlanesFiveDegreesApartThatTouchStayTwo) {
 
 TEST(MeasurementModelError, SizeFollowsDepthSquaredAndIndependentCells) {
   const WallAndCorner raw = wallAndCorner();
-  MeasurementModelError::Params p;
+  MeasurementModelError::Params p = calibrated();
   const Eigen::MatrixXd C = MeasurementModelError::covariance(raw.wall, p);
   ASSERT_EQ(C.rows(), 3);
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(C).eigenvalues().minCoeff(), 0.0);
@@ -192,11 +199,12 @@ TEST(MeasurementModelError, LeavesWhatItCannotScaleAlone) {
   EXPECT_EQ(MeasurementModelError::covariance(raw.wall, off).norm(), 0.0);
   QuadricMeasurement no_rms = raw.wall;
   no_rms.fit_rms = 0.0;  // no residual: the geometry cannot be recovered from the fit
-  EXPECT_EQ(MeasurementModelError::covariance(no_rms, {}).norm(), 0.0);
+  EXPECT_EQ(MeasurementModelError::covariance(no_rms, calibrated()).norm(), 0.0);
   QuadricMeasurement m = raw.wall;
-  MeasurementModelError::add(m, {});
+  MeasurementModelError::add(m, calibrated());
   EXPECT_TRUE(
-      m.covariance.isApprox(raw.wall.covariance + MeasurementModelError::covariance(raw.wall, {})));
+      m.covariance.isApprox(raw.wall.covariance +
+                            MeasurementModelError::covariance(raw.wall, calibrated())));
 }
 
 TEST(MeasurementModelError, ParamsValidate) {
@@ -209,7 +217,7 @@ TEST(MeasurementModelError, ParamsValidate) {
     }
     return std::string();
   };
-  MeasurementModelError::Params p;
+  MeasurementModelError::Params p = calibrated();
   p.sigma = -0.001;
   EXPECT_NE(message(p).find("sigma"), std::string::npos);
   p.sigma = 0.2;
