@@ -74,8 +74,9 @@ struct Options {
   bool quiet = false;
   bool rgb = true;    // read RGB when the input has it (it colours the reconstruction only)
   bool batch = true;  // false: no batch refinement whatever mapping.yaml says
-  // Reading and the front end (normals, segmentation) of the next frame on a second thread while
-  // the back end (odometry, mapping) works on this one: the same results, sooner on 2+ cores.
+  // Reading and the front end (normals, segmentation) of the next two frames on threads of their
+  // own while the back end (odometry, mapping) works on this one: the same results, sooner on 2+
+  // cores.
   bool pipelined = true;
   long max_frames = -1;
   long sample_every = 30;
@@ -104,10 +105,9 @@ int usage(const std::string& problem) {
       << "  --no-batch: no offline batch refinement (mapping.yaml batch_refinement): "
          "trajectory.txt\n"
       << "              and map.yaml are the online estimates\n"
-      << "  --sequential: one thread for the whole pipeline (by default the next frame is read "
-         "and\n"
-      << "                its normals and segmentation computed on a second thread meanwhile;\n"
-      << "                the results are the same)\n";
+      << "  --sequential: one thread for the whole pipeline (by default the next two frames are\n"
+      << "                read and their normals and segmentation computed on threads of their\n"
+      << "                own meanwhile; the results are the same)\n";
   return 2;
 }
 
@@ -325,29 +325,45 @@ int main(int argc, char** argv) {
     // How each measurement fared against the landmarks (AssociationOutcome, mapping/association.h).
     std::map<qs::AssociationOutcome, std::size_t> outcomes;
     const auto start = std::chrono::steady_clock::now();
-    // Two slots: the front end fills one (on its own thread when pipelined) while the back end
-    // takes the other. A frame's slot is not written again before its back end has run.
-    qs::RgbdFrame slot_frame[2];
-    qs::FrontEndFrame slot_front[2];
+    // Three slots: while the back end takes one frame, the front end (read, normals, segmentation)
+    // works on the next two, each on a thread of its own when pipelined (QuadricSlam::frontEnd is
+    // const and may run on two frames at once): on two cores the back end alone would leave one
+    // idle most of the time. Reads stay in frame order (each waits for the previous frame's read),
+    // and a slot is not written again before its frame's back end has run.
+    constexpr int kSlots = 3;
+    qs::RgbdFrame slot_frame[kSlots];
+    qs::FrontEndFrame slot_front[kSlots];
+    std::shared_future<bool> slot_read[kSlots];  // the slot's frame was read (false: no frame)
+    std::future<bool> slot_ready[kSlots];        // ... and its front end has run
     std::size_t read_count = 0;
-    auto readAndFrontEnd = [&](int slot) {
-      if (read_count >= total ||
-          !read_timer.time("read", [&] { return source->next(slot_frame[slot]); }))
-        return false;
-      ++read_count;
-      slam.frontEnd(slot_frame[slot], &slot_front[slot]);
-      return true;
+    auto startFrontEnd = [&](int slot, std::shared_future<bool> previous_read) {
+      auto read = std::make_shared<std::promise<bool>>();
+      slot_read[slot] = read->get_future().share();
+      slot_ready[slot] = std::async(
+          o.pipelined ? std::launch::async : std::launch::deferred, [&, slot, previous_read, read] {
+            bool ok = false;
+            try {
+              ok = (!previous_read.valid() || previous_read.get()) && read_count < total &&
+                   read_timer.time("read", [&] { return source->next(slot_frame[slot]); });
+            } catch (...) {  // the frames after this one are not read either
+              read->set_exception(std::current_exception());
+              throw;
+            }
+            read_count += ok;
+            read->set_value(ok);
+            if (ok)
+              slam.frontEnd(slot_frame[slot], &slot_front[slot]);
+            return ok;
+          });
     };
-    auto startFrontEnd = [&](int slot) {
-      return std::async(o.pipelined ? std::launch::async : std::launch::deferred, readAndFrontEnd,
-                        slot);
-    };
+    startFrontEnd(0, {});
+    startFrontEnd(1, slot_read[0]);
     int slot = 0;
-    std::future<bool> ahead = startFrontEnd(slot);
-    while (ahead.get()) {
+    while (slot_ready[slot].get()) {
       const int current = slot;
-      slot = 1 - slot;
-      ahead = startFrontEnd(slot);
+      slot = (slot + 1) % kSlots;
+      // The slot two ahead held the previous frame, whose back end has run.
+      startFrontEnd((current + 2) % kSlots, slot_read[(current + 1) % kSlots]);
       const qs::RgbdFrame& frame = slot_frame[current];
       ++frames;
       const qs::SlamFrameResult result = slam.backEnd(&slot_front[current]);

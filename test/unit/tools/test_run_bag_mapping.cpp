@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <pcl/io/pcd_io.h>
@@ -127,5 +129,21 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
   EXPECT_EQ(valueAfter(depth_only, "map_ate_rmse_m"), map_ate);
   EXPECT_EQ(quadric_slam::readMapYaml((dir / "out_depth/map.yaml").string()).quadrics.size(),
             map.quadrics.size());
+
+  // Pipelined (two frames ahead in the front end, each on its own thread) and --sequential give
+  // the same trajectory, to the last digit.
+  const std::string sequential =
+      run("run_bag",
+          (dir / "sequence").string() + " --out " + (dir / "out_sequential").string() +
+              " --quiet --no-rgb --sequential",
+          &code);
+  ASSERT_EQ(code, 0) << sequential;
+  const auto contents = [](const fs::path& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  const std::string pipelined_trajectory = contents(dir / "out_depth/trajectory.txt");
+  EXPECT_FALSE(pipelined_trajectory.empty());
+  EXPECT_EQ(contents(dir / "out_sequential/trajectory.txt"), pipelined_trajectory);
   fs::remove_all(dir);
 }
