@@ -70,7 +70,9 @@ Eigen::MatrixXd numericJacobian(const PrimitiveShape& shape,
 // basis). At zero: d t / d rho = R; the axis R e_c (c = x for a plane's normal, z for an axis)
 // moves as d (R e_c) / d phi = -R [e_c]x; a radius 1 / alpha_x moves by -r^2 per unit of alpha_x,
 // a cone's half angle atan(1 / alpha_x) by -1 / (1 + alpha_x^2).
-Eigen::Matrix<double, 7, Eigen::Dynamic> shapeParameterJacobian(const QuadricModel& quadric) {
+using ShapeParameterJacobian = Eigen::Matrix<double, 7, Eigen::Dynamic, 0, 7, 7>;  // on the stack
+
+ShapeParameterJacobian shapeParameterJacobian(const QuadricModel& quadric) {
   const Eigen::Matrix3d R = quadric.pose().linear();
   const QuadricClass c = quadric.quadricClass();
   Eigen::Matrix<double, 7, 9> full = Eigen::Matrix<double, 7, 9>::Zero();
@@ -102,6 +104,21 @@ std::vector<Eigen::Vector3d> subsample(const std::vector<Eigen::Vector3d>& all_p
   return points;
 }
 
+// The analytic Jacobian of the distances (not general): row i is base.distanceGradient(p_i)^T D.
+// The perturbation acts on the shape's core quadric, whose own (point, direction) may differ from
+// the shape's (e.g. a plane's point is the quadric origin offset * normal): base is that quadric's
+// shape, where the gradients are taken.
+struct DistanceChain {
+  PrimitiveShape base;
+  ShapeParameterJacobian D;
+
+  explicit DistanceChain(const PrimitiveShape& shape) {
+    const QuadricModel quadric = shape.quadric();
+    base = PrimitiveShape::fromQuadric(quadric);
+    D = shapeParameterJacobian(quadric);
+  }
+};
+
 // J^T J and J^T r for the distances' Jacobian J (distanceJacobian), accumulated point by point
 // without storing J (the refinement needs nothing else).
 void normalEquations(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points,
@@ -114,18 +131,16 @@ void normalEquations(const PrimitiveShape& shape, const std::vector<Eigen::Vecto
   }
   // J = G D with G the per-point gradients in (point, direction, size): accumulate the fixed-size
   // G^T G and G^T r, then H = D^T (G^T G) D and g = D^T (G^T r).
-  const QuadricModel quadric = shape.quadric();
-  const PrimitiveShape base = PrimitiveShape::fromQuadric(quadric);
-  const Eigen::Matrix<double, 7, Eigen::Dynamic> D = shapeParameterJacobian(quadric);
+  const DistanceChain chain(shape);
   Eigen::Matrix<double, 7, 7> GG = Eigen::Matrix<double, 7, 7>::Zero();
   Eigen::Matrix<double, 7, 1> Gr = Eigen::Matrix<double, 7, 1>::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Matrix<double, 7, 1> gradient = base.distanceGradient(points[i]);
+    const Eigen::Matrix<double, 7, 1> gradient = chain.base.distanceGradient(points[i]);
     GG.noalias() += gradient * gradient.transpose();
     Gr.noalias() += gradient * r[static_cast<Eigen::Index>(i)];
   }
-  H = D.transpose() * GG * D;
-  g = D.transpose() * Gr;
+  H = chain.D.transpose() * GG * chain.D;
+  g = chain.D.transpose() * Gr;
 }
 
 // Covariance of the fit: sigma^2 (J^T J)^-1, J over all points (the sub-sample's normal matrix
@@ -239,19 +254,13 @@ Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
                                  const std::vector<Eigen::Vector3d>& points) {
   if (shape.quadric_class == QuadricClass::kGeneral)
     return numericJacobian(shape, points);
-  // The perturbation acts on the shape's core quadric, whose own (point, direction) may differ from
-  // shape's (e.g. a plane's point is the quadric origin offset * normal): differentiate at it.
-  const QuadricModel quadric = shape.quadric();
-  const PrimitiveShape base = PrimitiveShape::fromQuadric(quadric);
-  const Eigen::Matrix<double, 7, Eigen::Dynamic> D = shapeParameterJacobian(quadric);
-  const int k = static_cast<int>(D.cols());
-  // D at most 7 x 7 on the stack: the per-row product needs no temporary on the heap (and a
-  // general matrix product of n x 7 by 7 x k costs more in packing than it saves).
-  const Eigen::Matrix<double, 7, Eigen::Dynamic, 0, 7, 7> D_small = D;
-  Eigen::MatrixXd J(points.size(), k);
+  // Row by row with D on the stack: no heap temporary per row (and a general matrix product of
+  // n x 7 by 7 x k costs more in packing than it saves).
+  const DistanceChain chain(shape);
+  Eigen::MatrixXd J(points.size(), chain.D.cols());
   for (std::size_t i = 0; i < points.size(); ++i)
     J.row(static_cast<Eigen::Index>(i)).noalias() =
-        base.distanceGradient(points[i]).transpose().lazyProduct(D_small);
+        chain.base.distanceGradient(points[i]).transpose().lazyProduct(chain.D);
   return J;
 }
 
