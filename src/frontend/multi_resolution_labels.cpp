@@ -16,6 +16,7 @@ QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) 
   c.planes.min_fragment_points = std::max(3, p.planes.min_fragment_points / (d * d));
   c.min_curved_points = std::max(4, p.min_curved_points / (d * d));
   c.planes.seed_stride = std::max(1, p.planes.seed_stride / d);
+  c.planes.cell_size = p.planes.cell_size / d;
   c.cgal_stride = std::max(1, (p.cgal_stride + d / 2) / d);
   c.decimation = 1;
   return c;
@@ -54,6 +55,7 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
   // Per-chunk tallies of the labelled points (rows split over threads), merged afterwards.
   struct Tally {
     std::vector<int> count;
+    std::vector<double> sum_sq;  // squared distances of the labelled points to their surface
     std::vector<Eigen::Vector3d> lo, hi;
     std::vector<ImageRoi> box;  // x, y min; width, height = max
   };
@@ -63,6 +65,7 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
   forEachChunk(height, threads, [&](int chunk, int v_begin, int v_end) {
     Tally& tally = tallies[chunk];
     tally.count.assign(n, 0);
+    tally.sum_sq.assign(n, 0.0);
     tally.lo.assign(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
     tally.hi.assign(n, Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
     tally.box.assign(n, ImageRoi{width, height, -1, -1});
@@ -122,6 +125,7 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
           result.labels.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(best);
           const int k = best - 1;
           ++tally.count[k];
+          tally.sum_sq[k] += best_distance * best_distance;
           const Eigen::Vector3d local = T_quadric_camera[k] * point;
           tally.lo[k] = tally.lo[k].cwiseMin(local);
           tally.hi[k] = tally.hi[k].cwiseMax(local);
@@ -135,6 +139,7 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
     }
   });
   std::vector<int> count(n, 0);
+  std::vector<double> sum_sq(n, 0.0);
   std::vector<Eigen::Vector3d> lo(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
   std::vector<Eigen::Vector3d> hi(n,
                                   Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
@@ -142,6 +147,7 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
   for (const Tally& tally : tallies) {
     for (int k = 0; k < n; ++k) {
       count[k] += tally.count[k];
+      sum_sq[k] += tally.sum_sq[k];
       lo[k] = lo[k].cwiseMin(tally.lo[k]);
       hi[k] = hi[k].cwiseMax(tally.hi[k]);
       box[k].x_offset = std::min(box[k].x_offset, tally.box[k].x_offset);
@@ -158,9 +164,15 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
     QuadricDetection detection = coarse.detections[k];
     detection.label = static_cast<std::uint16_t>(result.detections.size() + 1);
     relabel[k + 1] = detection.label;
-    // More points of the same noise: the covariance shrinks with the support.
+    // The covariance, sigma^2 (J^T J)^-1, follows the full-resolution support: J^T J grows with
+    // the points, sigma^2 is their residual variance (the coarse fit's points may include a wider
+    // band: plane cells take their pixels without a normal test).
+    const double rms = std::sqrt(sum_sq[k] / count[k]);
+    if (detection.fit_rms > 0)
+      detection.covariance *= std::pow(rms / detection.fit_rms, 2);
     detection.covariance *= static_cast<double>(detection.num_points) / count[k];
     detection.num_points = count[k];
+    detection.fit_rms = rms;
     detection.extent_min = lo[k];
     detection.extent_max = hi[k];
     detection.roi = ImageRoi{box[k].x_offset, box[k].y_offset, box[k].width - box[k].x_offset + 1,

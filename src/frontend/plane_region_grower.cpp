@@ -7,6 +7,8 @@
 #include <string>
 
 #include "quadric_slam/frontend/grid_flood.h"
+#include "quadric_slam/frontend/plane_cells.h"
+#include "quadric_slam/frontend/point_moments.h"
 #include "quadric_slam/frontend/segmentation_frame.h"
 
 namespace quadric_slam {
@@ -18,37 +20,20 @@ void require(bool ok, const std::string& message) {
     throw std::invalid_argument("PlaneRegionGrower: " + message);
 }
 
-// Running first and second moments of a growing region, about a fixed reference point.
+// A growing region: its points' moments and the sum of their normals.
 struct Moments {
-  Eigen::Vector3d reference = Eigen::Vector3d::Zero();
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d sum_sq = Eigen::Matrix3d::Zero();
+  PointMoments points;
   Eigen::Vector3d sum_normals = Eigen::Vector3d::Zero();
-  double count = 0;
 
   void add(const Eigen::Vector3d& p, const Eigen::Vector3d& normal) {
-    const Eigen::Vector3d q = p - reference;
-    sum += q;
-    sum_sq += q * q.transpose();
+    points.add(p);
     sum_normals += normal;
-    count += 1;
   }
   // Growth criterion while the region is small: the mean of its (smoothed) point normals is far
   // less noisy than a PCA plane through a few noisy points.
   void meanNormalPlane(Eigen::Vector3d& n, double& d) const {
     n = sum_normals.normalized();
-    d = n.dot(sum / count + reference);
-  }
-  // Plane n.p = d through the centroid (normal towards the camera).
-  void plane(Eigen::Vector3d& n, double& d) const {
-    const Eigen::Vector3d mean = sum / count;
-    const Eigen::Matrix3d C = sum_sq / count - mean * mean.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
-    n = eig.eigenvectors().col(0);
-    const Eigen::Vector3d centroid = mean + reference;
-    if (n.dot(centroid) > 0)
-      n = -n;
-    d = n.dot(centroid);
+    d = n.dot(points.centroid());
   }
 };
 
@@ -99,6 +84,10 @@ void PlaneRegionGrower::Params::validate() const {
           "min_fragment_points must be >= 3, got " + std::to_string(min_fragment_points));
   require(merge_rms_factor >= 1 && merge_rms_factor <= 10,
           "merge_rms_factor must be in [1, 10], got " + std::to_string(merge_rms_factor));
+  require(cell_size >= 0 && cell_size <= 64,
+          "cell_size must be in [0, 64] pixels, got " + std::to_string(cell_size));
+  require(cell_min_depth >= 0 && cell_min_depth <= 10,
+          "cell_min_depth must be in [0, 10] m, got " + std::to_string(cell_min_depth));
   require(fill_max_normal_angle >= 0 && fill_max_normal_angle < M_PI / 2,
           "fill_max_normal_angle must be in [0, pi/2) rad, got " +
               std::to_string(fill_max_normal_angle));
@@ -110,12 +99,22 @@ double kinectDepthSigma(double z, double noise_scale, double quantisation_factor
   return std::sqrt(axial * axial + step * step / 12.0);
 }
 
-double PlaneRegionGrower::pointThreshold(double z) const {
+double planePointThreshold(double z, const PlaneRegionGrower::Params& params) {
   return std::max(
-      depthThreshold(z, params_.distance_factor, params_.min_distance),
-      params_.noise_sigmas * kinectDepthSigma(z, params_.noise_scale, params_.quantisation_factor) +
-          params_.bend_factor * z * z);
+      depthThreshold(z, params.distance_factor, params.min_distance),
+      params.noise_sigmas * kinectDepthSigma(z, params.noise_scale, params.quantisation_factor) +
+          params.bend_factor * z * z);
 }
+
+double planePointVariance(double z, const PlaneRegionGrower::Params& params) {
+  // kinectDepthSigma squared, without its square root (called per point).
+  const double axial = params.noise_scale * (0.0012 + 0.0019 * (z - 0.4) * (z - 0.4));
+  const double z2 = z * z;
+  const double step = params.quantisation_factor * z2;
+  const double bend = params.bend_factor * z2;
+  return axial * axial + step * step / 12.0 + bend * bend;
+}
+
 
 PlaneRegionGrower::PlaneRegionGrower(const Params& params) : params_(params) {
   params_.validate();
@@ -161,7 +160,11 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::grow(
     std::vector<std::uint8_t>& used) const {
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
   const double cos_angle = std::cos(params_.max_normal_angle);
-  std::vector<Region> regions;
+  // Cells first (plane_cells.h): large and far surfaces, filled out to their borders at once (or
+  // the pixels along an occluding edge, in cells that straddle it, would grow regions of their
+  // own); then pixels, for what the cells left.
+  std::vector<Region> regions = growPlaneCells(cloud, valid, used, params_);
+  fill(cloud, valid, used, regions);
   // 0 = free, 1 = in the current region, 2 = tried as part of a rejected region (no seed).
   std::vector<std::uint8_t> state(cloud.size(), 0);
   std::vector<int> queue;
@@ -173,18 +176,18 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::grow(
       if (!valid[seed] || used[seed] || state[seed] != 0)
         continue;
       Moments moments;
-      moments.reference = pointOf(cloud.points[seed]);
+      moments.points.reference = pointOf(cloud.points[seed]);
       Eigen::Vector3d n = normalOf(cloud.points[seed]).normalized();
       if (!seedIsSmooth(cloud, valid, seed, n, cos_angle)) {
         state[seed] = 2;
         continue;
       }
-      double d = n.dot(moments.reference);
+      double d = n.dot(moments.points.reference);
       double next_refit = 16;
       queue.clear();
       queue.push_back(seed);
       state[seed] = 1;
-      moments.add(moments.reference, n);
+      moments.add(moments.points.reference, n);
       floodFill4(width, height, queue, [&](int i, int j) {
         if (!valid[j] || used[j] || state[j] == 1)
           return false;
@@ -197,11 +200,11 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::grow(
         const double agreement = n.dot(normal);
         if (std::abs(agreement) < cos_angle)
           return false;
-        if (std::abs(n.dot(p) - d) > pointThreshold(q.z))
+        if (!withinPlaneThreshold(std::abs(n.dot(p) - d), q.z, params_))
           return false;
         state[j] = 1;
         moments.add(p, agreement < 0 ? Eigen::Vector3d(-normal) : normal);
-        if (moments.count >= next_refit) {
+        if (moments.points.count >= next_refit) {
           moments.meanNormalPlane(n, d);
           next_refit *= 2;
         }
@@ -212,14 +215,16 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::grow(
       bool accepted = static_cast<int>(queue.size()) >=
                       std::min(params_.min_points, params_.min_fragment_points);
       if (accepted) {
-        moments.plane(n, d);
+        const MomentPlane fit(moments.points);
+        n = fit.normal;
+        d = fit.offset();
         std::vector<int> indices(queue.begin(), queue.end());
         accepted = patchCurvature(cloud, indices, n) <= params_.max_curvature;
         if (accepted) {
           Region region;
           region.indices = std::move(indices);
           region.plane = PrimitiveShape::plane(n, d);
-          region.plane.point = moments.sum / moments.count + moments.reference;
+          region.plane.point = fit.centroid;
           for (int i : region.indices)
             used[i] = 1;
           regions.push_back(std::move(region));
@@ -247,7 +252,7 @@ namespace {
 
 // A region's plane and its noise-derived uncertainty, from its points' moments.
 struct PlaneStats {
-  Moments moments;
+  PointMoments moments;
   double sum_variance = 0;  // sum over the points of sigma(z)^2 + bend(z)^2 (m^2)
   Eigen::Vector3d normal, centroid, axis1, axis2;
   double rms = 0;                   // RMS distance of the points to the plane (m)
@@ -256,25 +261,24 @@ struct PlaneStats {
 
   void update() {
     count = moments.count;
-    centroid = moments.sum / count + moments.reference;
-    const Eigen::Vector3d mean = moments.sum / count;
-    const Eigen::Matrix3d C = moments.sum_sq / count - mean * mean.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(C);
-    normal = eig.eigenvectors().col(0);
-    if (normal.dot(centroid) > 0)
-      normal = -normal;
-    axis1 = eig.eigenvectors().col(1);
-    axis2 = eig.eigenvectors().col(2);
-    rms = std::sqrt(std::max(0.0, eig.eigenvalues()[0]));
-    spread1 = std::max(1e-8, eig.eigenvalues()[1]);
-    spread2 = std::max(1e-8, eig.eigenvalues()[2]);
+    const MomentPlane fit(moments);
+    centroid = fit.centroid;
+    normal = fit.normal;
+    axis1 = fit.axes.col(1);
+    axis2 = fit.axes.col(2);
+    rms = fit.rms();
+    spread1 = std::max(1e-8, fit.eigenvalues[1]);
+    spread2 = std::max(1e-8, fit.eigenvalues[2]);
+  }
+  void add(const PlaneStats& other) {
+    moments.add(other.moments);
+    sum_variance += other.sum_variance;
+    update();
   }
   // Mean expected variance of a point's distance to the plane (noise and bend, m^2).
   double noiseVariance() const { return sum_variance / count; }
-  // Independent measurements: neighbouring Kinect depths share the disparity matcher's window,
-  // so a region of N grid points carries about N / kCorrelatedPoints independent ones.
-  static constexpr double kCorrelatedPoints = 16.0;
-  double independent() const { return std::max(1.0, count / kCorrelatedPoints); }
+  // Independent measurements among the region's points (kCorrelatedDepthPoints).
+  double independent() const { return std::max(1.0, count / kCorrelatedDepthPoints); }
   // Variance of the plane's offset at x (m^2): the centroid's, and the normal's tilt about it.
   double offsetVariance(const Eigen::Vector3d& x) const {
     const double noise = noiseVariance() / independent();
@@ -296,19 +300,14 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::mergeCoplanar(
   std::stable_sort(regions.begin(), regions.end(), [](const Region& a, const Region& b) {
     return a.indices.size() > b.indices.size();
   });
-  const auto variance = [&](double z) {
-    const double s = kinectDepthSigma(z, params_.noise_scale, params_.quantisation_factor);
-    const double bend = params_.bend_factor * z * z;
-    return s * s + bend * bend;
-  };
   std::vector<PlaneStats> stats(regions.size());
   for (std::size_t r = 0; r < regions.size(); ++r) {
     PlaneStats& st = stats[r];
     st.moments.reference = regions[r].plane.point;
     for (int k : regions[r].indices) {
       const pcl::PointNormal& q = cloud.points[k];
-      st.moments.add(pointOf(q), Eigen::Vector3d::Zero());
-      st.sum_variance += variance(q.z);
+      st.moments.add(pointOf(q));
+      st.sum_variance += planePointVariance(q.z, params_);
     }
     st.update();
   }
@@ -337,14 +336,7 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::mergeCoplanar(
         return false;
     }
     PlaneStats merged = a;
-    Moments& m = merged.moments;
-    const Eigen::Vector3d shift = b.moments.reference - m.reference;
-    m.sum_sq += b.moments.sum_sq + b.moments.sum * shift.transpose() +
-                shift * b.moments.sum.transpose() + b.moments.count * shift * shift.transpose();
-    m.sum += b.moments.sum + b.moments.count * shift;
-    m.count += b.moments.count;
-    merged.sum_variance += b.sum_variance;
-    merged.update();
+    merged.add(b);
     return merged.rms <= params_.merge_rms_factor * std::sqrt(merged.noiseVariance());
   };
   bool merged_any = true;
@@ -359,15 +351,7 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::mergeCoplanar(
         Region& a = regions[i];
         a.indices.insert(a.indices.end(), regions[j].indices.begin(), regions[j].indices.end());
         PlaneStats& st = stats[i];
-        const PlaneStats& other = stats[j];
-        const Eigen::Vector3d shift = other.moments.reference - st.moments.reference;
-        st.moments.sum_sq += other.moments.sum_sq + other.moments.sum * shift.transpose() +
-                             shift * other.moments.sum.transpose() +
-                             other.moments.count * shift * shift.transpose();
-        st.moments.sum += other.moments.sum + other.moments.count * shift;
-        st.moments.count += other.moments.count;
-        st.sum_variance += other.sum_variance;
-        st.update();
+        st.add(stats[j]);
         a.plane = PrimitiveShape::plane(st.normal, st.normal.dot(st.centroid));
         a.plane.point = st.centroid;
         regions.erase(regions.begin() + j);
@@ -400,7 +384,7 @@ void PlaneRegionGrower::fill(const pcl::PointCloud<pcl::PointNormal>& cloud,
         return false;
       if (std::abs(n.dot(normalOf(q))) < cos_angle)
         return false;
-      if (std::abs(n.dot(pointOf(q)) - d) > pointThreshold(q.z))
+      if (!withinPlaneThreshold(std::abs(n.dot(pointOf(q)) - d), q.z, params_))
         return false;
       used[j] = 1;
       region.indices.push_back(j);

@@ -58,6 +58,8 @@ const std::vector<Entry>& table() {
            [](Params& p) -> double& { return p.planes.merge_rms_factor; }),
       real("plane_fill_max_normal_angle",
            [](Params& p) -> double& { return p.planes.fill_max_normal_angle; }),
+      integer("plane_cell_size", [](Params& p) -> int& { return p.planes.cell_size; }),
+      real("plane_cell_min_depth", [](Params& p) -> double& { return p.planes.cell_min_depth; }),
       flag("detect_spheres", [](Params& p) -> bool& { return p.detect_spheres; }),
       flag("detect_cylinders", [](Params& p) -> bool& { return p.detect_cylinders; }),
       flag("detect_cones", [](Params& p) -> bool& { return p.detect_cones; }),

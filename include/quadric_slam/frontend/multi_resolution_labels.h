@@ -16,7 +16,7 @@ QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d);
 // the label of a neighbouring coarse sample whose surface it fits (distance threshold and normal
 // agreement, as on the coarse grid; no normal needed within 3 x the fit's RMS of a surface that is
 // the only one among the neighbouring samples);
-// support, ROI, extent and covariance follow the full-resolution points.
+// support, fit RMS, ROI, extent and covariance follow the full-resolution points.
 Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
                       const QuadricSegmenter::Params& p);
 

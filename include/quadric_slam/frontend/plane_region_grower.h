@@ -28,6 +28,10 @@ inline double depthThreshold(double z, double factor, double min_distance) {
 // quantisation (1/8 pixel: a step of quantisation_factor * z^2, uniform, std step / sqrt(12)).
 double kinectDepthSigma(double z, double noise_scale, double quantisation_factor);
 
+// Neighbouring Kinect depths share the disparity matcher's window: N grid points of one surface
+// carry about N / kCorrelatedDepthPoints independent measurements (plane and cell uncertainties).
+constexpr double kCorrelatedDepthPoints = 16.0;
+
 class PlaneRegionGrower {
  public:
   struct Params {
@@ -78,6 +82,16 @@ class PlaneRegionGrower {
     // threshold of its final plane and with a normal within fill_max_normal_angle (rad), [0,
     // pi/2); 0 = no filling. Default 0.45 (far normals are noisy; the distance test decides).
     double fill_max_normal_angle = 0.45;
+    // Planes are first grown over square cells of cell_size x cell_size pixels of the cloud grid,
+    // judged by the cells' own plane fits rather than the pixels' normals (plane_cells.h), then
+    // over the pixels the cells left; [0, 64], 0 or 1 = pixels only. Default 16 (full-resolution
+    // pixels: about 11 cm at 4 m).
+    int cell_size = 16;
+    // Cells nearer than this mean depth (m) are left to the pixel grower, [0, 10]. Near, pixel
+    // normals are good, and their test keeps apart parallel surfaces a centimetre or two apart (a
+    // cabinet door and its frame) that a cell's noise band would join (on the real kitchen
+    // sequence cells at all depths made the trajectory worse). Default 2.
+    double cell_min_depth = 2.0;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -106,8 +120,6 @@ class PlaneRegionGrower {
   // Adds the free points connected to each region that fit its plane (fill_max_normal_angle).
   void fill(const pcl::PointCloud<pcl::PointNormal>& cloud, const std::vector<std::uint8_t>& valid,
             std::vector<std::uint8_t>& used, std::vector<Region>& regions) const;
-  // Distance threshold of a point at depth z to its plane (growing and filling).
-  double pointThreshold(double z) const;
 
   Params params_;
 };
@@ -115,6 +127,22 @@ class PlaneRegionGrower {
 // Largest absolute eigenvalue of the least-squares shape operator of a patch around its plane:
 // the 2x2 map from in-plane position to in-plane normal change (1/m). ~0 for a plane, 1/r for a
 // cylinder or sphere of radius r.
+// Distance threshold of a point at depth z to its plane when growing and filling (m):
+// max(max(min_distance, distance_factor z^2), noise_sigmas sigma(z) + bend_factor z^2).
+double planePointThreshold(double z, const PlaneRegionGrower::Params& params);
+
+// distance <= planePointThreshold(z, params); the depth-scaled threshold first, which needs no
+// square root and decides most points.
+inline bool withinPlaneThreshold(double distance, double z,
+                                 const PlaneRegionGrower::Params& params) {
+  return distance <= depthThreshold(z, params.distance_factor, params.min_distance) ||
+         distance <= planePointThreshold(z, params);
+}
+
+// Expected variance of a point's distance to its plane at depth z (m^2): the sensor's noise
+// (kinectDepthSigma) and the bend (bend_factor z^2).
+double planePointVariance(double z, const PlaneRegionGrower::Params& params);
+
 double patchCurvature(const pcl::PointCloud<pcl::PointNormal>& cloud,
                       const std::vector<int>& indices, const Eigen::Vector3d& plane_normal);
 
