@@ -1,7 +1,7 @@
 // Planes grown over cells of the image grid rather than pixels, after CAPE (Proenca and Gao, "Fast
 // Cylinder and Plane Extraction from Depth Cameras for Visual Odometry", IROS 2018).
 //
-// Beyond about 2.5 m a Kinect's depth noise (centimetres, in disparity steps) makes per-pixel
+// Beyond about 3 m a Kinect's depth noise (centimetres, in disparity steps) makes per-pixel
 // normals too noisy to grow a wall or floor pixel by pixel: it comes out in fragments or not at
 // all. A square cell of cell_size x cell_size pixels averages that noise: its plane is far
 // steadier than any pixel normal, and its RMS says whether it is flat within the sensor's noise.

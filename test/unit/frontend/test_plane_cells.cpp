@@ -92,7 +92,7 @@ std::vector<std::uint8_t> validOf(const pcl::PointCloud<pcl::PointNormal>& cloud
 }
 
 // The grower's parameters on the grid decimated by 2 (multi_resolution_labels.h's coarseParams).
-qs::PlaneRegionGrower::Params coarseGrowerParams(int cell_size, double cell_min_depth = 2.0) {
+qs::PlaneRegionGrower::Params coarseGrowerParams(int cell_size, double cell_min_depth = 3.0) {
   qs::PlaneRegionGrower::Params p;
   p.cell_min_depth = cell_min_depth;
   p.min_points = 125;
@@ -153,7 +153,7 @@ TEST(PlaneCells, FarWallWithNoisyNormalsIsOneRegion) {
   EXPECT_LT(pixel_recall, 0.5) << "the scene no longer shows what the cells are for";
 }
 
-// A floor meeting a wall at 2.5-3.5 m: two regions, neither taking the other's pixels along the
+// A floor meeting a wall at 2.5-3.5 m, cells from 2 m: two regions, neither taking the other's pixels along the
 // crease (where the wall's pixels lie within the floor's distance threshold).
 TEST(PlaneCells, CreaseKeepsTwoSurfacesApart) {
   const Eigen::Vector3d floor_n(0.0, -1.0, 0.0), wall_n(0.0, 0.0, -1.0);
@@ -164,7 +164,7 @@ TEST(PlaneCells, CreaseKeepsTwoSurfacesApart) {
              0.05, truth);
   const auto valid = validOf(cloud);
   std::vector<std::uint8_t> used(cloud.size(), 0);
-  const auto regions = qs::growPlaneCells(cloud, valid, used, coarseGrowerParams(8));
+  const auto regions = qs::growPlaneCells(cloud, valid, used, coarseGrowerParams(8, 2.0));
   for (int surface : {0, 1}) {
     SCOPED_TRACE(surface == 0 ? "floor" : "wall");
     double recall = 0, precision = 0;
@@ -203,7 +203,7 @@ TEST(PlaneCells, CurvedSurfaceGivesNoRegion) {
   EXPECT_EQ(std::count(used.begin(), used.end(), 1), 0);
 }
 
-// A wall at 1.5 m is left to the pixel grower with the default cell_min_depth (2 m) and grown by
+// A wall at 1.5 m is left to the pixel grower with the default cell_min_depth (3 m) and grown by
 // the cells without it.
 TEST(PlaneCells, NearSurfacesAreLeftToThePixels) {
   std::vector<int> truth;
