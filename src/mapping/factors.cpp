@@ -39,6 +39,8 @@ QuadricObservationCost::QuadricObservationCost(const QuadricModel& z_camera,
                                 toString(z_camera.quadricClass()));
   sqrt_information_ = sqrt_information;
   basis_pinv_ = basisPseudoInverse(z_camera.quadricClass());
+  for (int index : classDefinition(z_camera.quadricClass()).dropped_pose_indices)
+    dropped_.at(num_dropped_++) = index;
   set_num_residuals(k);
   mutable_parameter_block_sizes()->push_back(kPoseParameterSize);
   mutable_parameter_block_sizes()->push_back(kQuadricParameterSize);
@@ -50,8 +52,24 @@ ceres::CostFunction* QuadricObservationCost::Create(const QuadricModel& z_camera
                                     sqrtInformation(covariance, "QuadricObservationCost"));
 }
 
-bool QuadricObservationCost::Evaluate(double const* const* parameters, double* residuals,
-                                      double** jacobians) const {
+namespace {
+
+// minimalAdjoint(c, G) (geometry/symmetry.h: M = B^+ blockdiag(Ad_G, I) B) with stack matrices;
+// a general quadric's relabelling of the scale block is left to minimalAdjoint itself.
+QuadricObservationCost::MatrixKK minimalAdjointOnStack(QuadricClass c,
+                                                       const Eigen::Isometry3d& G) {
+  if (c == QuadricClass::kGeneral)
+    return minimalAdjoint(c, G);
+  Eigen::Matrix<double, 9, 9> ad = Eigen::Matrix<double, 9, 9>::Identity();
+  ad.topLeftCorner<6, 6>() = adjointSE3(G);
+  const QuadricObservationCost::MatrixK9 B_pinv_ad = basisPseudoInverse(c).lazyProduct(ad);
+  return B_pinv_ad.lazyProduct(classDefinition(c).basis);
+}
+
+}  // namespace
+
+void QuadricObservationCost::evaluateTangent(double const* const* parameters, double* residuals,
+                                             MatrixK6* J_camera, MatrixK9* J_general) const {
   const QuadricClass c = z_.quadricClass();
   const Eigen::Isometry3d T_world_camera = poseFromParameters(parameters[0]);
   const Eigen::Isometry3d T_world_quadric = poseFromParameters(parameters[1]);
@@ -64,30 +82,65 @@ bool QuadricObservationCost::Evaluate(double const* const* parameters, double* r
   Vector9d r9;
   r9.head<6>() = logSE3(G.inverse() * D);              // eq. 14: h [-] z G
   r9.tail<3>() = scale - withSymmetry(z_, G).scale();  // eq. 17
-  const Eigen::MatrixXd LM = sqrt_information_ * minimalAdjoint(c, G);
+  // (Products of these small matrices are written lazyProduct: Eigen's blocked GEMM, which it
+  // picks for bounded sizes over 20 in sum, costs more than the arithmetic here.)
+  const MatrixKK LM = sqrt_information_.lazyProduct(minimalAdjointOnStack(c, G));
   const int k = num_residuals();
-  Eigen::Map<Eigen::VectorXd>(residuals, k) = LM * (basis_pinv_ * r9);
-  if (jacobians == nullptr)
-    return true;
+  const Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 9, 1> x =
+      basis_pinv_.lazyProduct(r9);
+  Eigen::Map<Eigen::VectorXd>(residuals, k) = LM.lazyProduct(x);
+  if (J_camera == nullptr || J_general == nullptr)
+    return;
   const Vector6d e = r9.head<6>();
-  const Matrix6d K = alignedErrorJacobian(c, e);
-  // d r / d delta (D exp(delta^)), k x 6: the error's rate and the whitening's rate through G.
-  Eigen::Matrix<double, 9, 6> de9 = Eigen::Matrix<double, 9, 6>::Zero();
-  de9.topRows<6>() = K;
-  Eigen::Matrix<double, 9, 6> dM9 = Eigen::Matrix<double, 9, 6>::Zero();
-  dM9.topRows<6>() = adjointSE3(G) * adSE3(e) * alignmentGeneratorRate(c, e);
-  const Eigen::MatrixXd LN = LM * basis_pinv_ * de9 - sqrt_information_ * basis_pinv_ * dM9;
-  if (jacobians[0] != nullptr) {
+  // J_l^-1 and J_r^-1 at e once, for both rates below (geometry/symmetry.h):
+  //   Gamma = P^T (P J_l^-1 P^T)^-1 P J_r^-1  (alignmentGeneratorRate),
+  //   K = J_r^-1 - J_l^-1 Gamma               (alignedErrorJacobian).
+  const Matrix6d Jl_inv = leftJacobianInverseSE3(e);
+  const Matrix6d Jr_inv = rightJacobianInverseSE3(e);
+  Matrix6d Gamma = Matrix6d::Zero();
+  const int m = num_dropped_;
+  if (m > 0) {
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, 6> PJP(m, m);
+    Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 6, 6> PJr(m, 6);
+    for (int i = 0; i < m; ++i) {
+      PJr.row(i) = Jr_inv.row(dropped_[i]);
+      for (int j = 0; j < m; ++j)
+        PJP(i, j) = Jl_inv(dropped_[i], dropped_[j]);
+    }
+    const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 6, 6> rows =
+        PJP.inverse() * PJr;
+    for (int i = 0; i < m; ++i)
+      Gamma.row(dropped_[i]) = rows.row(i);
+  }
+  const Matrix6d K = Jr_inv - Jl_inv * Gamma;
+  // d r / d delta (D exp(delta^)), k x 6: the error's rate and the whitening's rate through G
+  // (the scale rows of both are zero, so only B^+'s pose columns take part).
+  const Matrix6d dM6 = adjointSE3(G) * adSE3(e) * Gamma;
+  const MatrixK6 BK = basis_pinv_.leftCols<6>().lazyProduct(K);
+  const MatrixK6 BdM = basis_pinv_.leftCols<6>().lazyProduct(dM6);
+  const MatrixK6 LN = LM.lazyProduct(BK) - sqrt_information_.lazyProduct(BdM);
+  *J_camera = -LN.lazyProduct(adjointSE3(h.inverse()));
+  J_general->resize(k, 9);
+  J_general->leftCols<6>() = LN;
+  J_general->rightCols<3>() = LM.lazyProduct(basis_pinv_.rightCols<3>());
+}
+
+bool QuadricObservationCost::Evaluate(double const* const* parameters, double* residuals,
+                                      double** jacobians) const {
+  if (jacobians == nullptr || (jacobians[0] == nullptr && jacobians[1] == nullptr)) {
+    evaluateTangent(parameters, residuals, nullptr, nullptr);
+    return true;
+  }
+  MatrixK6 J_camera;
+  MatrixK9 J_general;
+  evaluateTangent(parameters, residuals, &J_camera, &J_general);
+  const int k = num_residuals();
+  if (jacobians[0] != nullptr)
     Eigen::Map<RowMajorMatrix>(jacobians[0], k, kPoseParameterSize) =
-        -LN * adjointSE3(h.inverse()) * poseMinusJacobian(parameters[0]);
-  }
-  if (jacobians[1] != nullptr) {
-    Eigen::MatrixXd dr_dq9(k, 9);
-    dr_dq9.leftCols<6>() = LN;
-    dr_dq9.rightCols<3>() = LM * basis_pinv_.rightCols<3>();
+        J_camera.lazyProduct(poseMinusJacobian(parameters[0]));
+  if (jacobians[1] != nullptr)
     Eigen::Map<RowMajorMatrix>(jacobians[1], k, kQuadricParameterSize) =
-        dr_dq9 * quadricGeneralMinusJacobian(parameters[1]);
-  }
+        J_general.lazyProduct(quadricGeneralMinusJacobian(parameters[1]));
   return true;
 }
 
