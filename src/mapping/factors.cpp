@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/geometry/quadric_classes.h"
@@ -99,19 +100,26 @@ void QuadricObservationCost::evaluateTangent(double const* const* parameters, do
   const Matrix6d Jr_inv = rightJacobianInverseSE3(e);
   Matrix6d Gamma = Matrix6d::Zero();
   const int m = num_dropped_;
-  if (m > 0) {
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 6, 6> PJP(m, m);
-    Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 6, 6> PJr(m, 6);
-    for (int i = 0; i < m; ++i) {
+  // m = 1..3 dropped components: P J_l^-1 P^T is at most 3 x 3 (closed-form inverse).
+  auto rate = [&](auto dropped_count) {
+    constexpr int kM = decltype(dropped_count)::value;
+    Eigen::Matrix<double, kM, kM> PJP;
+    Eigen::Matrix<double, kM, 6> PJr;
+    for (int i = 0; i < kM; ++i) {
       PJr.row(i) = Jr_inv.row(dropped_[i]);
-      for (int j = 0; j < m; ++j)
+      for (int j = 0; j < kM; ++j)
         PJP(i, j) = Jl_inv(dropped_[i], dropped_[j]);
     }
-    const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 6, 6> rows =
-        PJP.inverse() * PJr;
-    for (int i = 0; i < m; ++i)
+    const Eigen::Matrix<double, kM, 6> rows = PJP.inverse() * PJr;
+    for (int i = 0; i < kM; ++i)
       Gamma.row(dropped_[i]) = rows.row(i);
-  }
+  };
+  if (m == 1)
+    rate(std::integral_constant<int, 1>());
+  else if (m == 2)
+    rate(std::integral_constant<int, 2>());
+  else if (m == 3)
+    rate(std::integral_constant<int, 3>());
   const Matrix6d K = Jr_inv - Jl_inv * Gamma;
   // d r / d delta (D exp(delta^)), k x 6: the error's rate and the whitening's rate through G
   // (the scale rows of both are zero, so only B^+'s pose columns take part).
