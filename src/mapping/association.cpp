@@ -104,22 +104,27 @@ double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
   const ObservationLinearization lin = linearizeObservation(z, T_map_camera, target.quadric_map);
   if (!lin.valid)
     return std::numeric_limits<double>::infinity();
-  const Eigen::VectorXd& r0 = lin.residual;
-  const Eigen::MatrixXd& J_c = lin.J_camera;
-  const Eigen::MatrixXd& J_q = lin.J_quadric;
+  // k <= 9: S and its factor on the stack (d^2 is computed for every overlapping pair).
+  using MatrixKK = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 9, 9>;
+  using MatrixK6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 9, 6>;
+  const MatrixK6& J_c = lin.J_camera;
+  const MatrixKK& J_q = lin.J_quadric;
 
   Matrix6d P = pose_covariance;
   const double st = params_.pose_translation_sigma, sr = params_.pose_rotation_sigma;
   P.diagonal() += (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr).finished();
-  Eigen::MatrixXd S = measurement.covariance + floorCovariance(params_, target.quadric_map) +
-                      J_c * P * J_c.transpose();
-  if (target.covariance.size() != 0)
-    S += J_q * target.covariance * J_q.transpose();
+  const MatrixK6 J_c_P = J_c.lazyProduct(P);
+  MatrixKK S = measurement.covariance + floorCovariance(params_, target.quadric_map);
+  S += J_c_P.lazyProduct(J_c.transpose());
+  if (target.covariance.size() != 0) {
+    const MatrixKK J_q_C = J_q.lazyProduct(target.covariance);
+    S += J_q_C.lazyProduct(J_q.transpose());
+  }
   S = 0.5 * (S + S.transpose()).eval();
-  const Eigen::LLT<Eigen::MatrixXd> llt(S);
+  const Eigen::LLT<MatrixKK> llt(S);
   if (llt.info() != Eigen::Success)
     throw std::invalid_argument("QuadricAssociator: innovation covariance not positive definite");
-  return r0.dot(llt.solve(r0));
+  return lin.residual.dot(llt.solve(lin.residual));
 }
 
 bool QuadricAssociator::inRange(const QuadricModel& quadric_map, const ExtentBox& extent,

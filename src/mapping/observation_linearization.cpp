@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "quadric_slam/geometry/manifolds.h"
+#include "quadric_slam/geometry/quadric_classes.h"
 #include "quadric_slam/mapping/factors.h"
 
 namespace quadric_slam {
@@ -11,12 +12,12 @@ namespace quadric_slam {
 ObservationLinearization linearizeObservation(const QuadricModel& z_camera,
                                               const Eigen::Isometry3d& T_map_camera,
                                               const QuadricModel& landmark_map) {
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   const QuadricClass c = z_camera.quadricClass();
   if (landmark_map.quadricClass() != c)
     throw std::invalid_argument("linearizeObservation: measurement and landmark classes differ");
   const int k = minimalDimension(c);
-  const QuadricObservationCost cost(z_camera, Eigen::MatrixXd::Identity(k, k));
+  const QuadricObservationCost cost(z_camera,
+                                    QuadricObservationCost::MatrixKK::Identity(k, k));
   std::array<double, kPoseParameterSize> pose;
   std::array<double, kQuadricParameterSize> quadric;
   poseToParameters(T_map_camera, pose.data());
@@ -24,15 +25,11 @@ ObservationLinearization linearizeObservation(const QuadricModel& z_camera,
   const double* blocks[2] = {pose.data(), quadric.data()};
   ObservationLinearization out;
   out.residual.resize(k);
-  RowMajor J_pose(k, kPoseParameterSize), J_quadric(k, kQuadricParameterSize);
-  double* jacobians[2] = {J_pose.data(), J_quadric.data()};
-  if (!cost.Evaluate(blocks, out.residual.data(), jacobians))
-    return out;
-  out.J_camera = J_pose * posePlusJacobian(pose.data());
-  const QuadricManifold manifold(c);
-  RowMajor plus_q(kQuadricParameterSize, k);
-  manifold.PlusJacobian(quadric.data(), plus_q.data());
-  out.J_quadric = J_quadric * plus_q;
+  // Straight in the tangent spaces (the same as the cost's ambient Jacobians times the blocks'
+  // PlusJacobians, without the round trip through the 7- and 10-parameter blocks).
+  QuadricObservationCost::MatrixK9 J_general;
+  cost.evaluateTangent(blocks, out.residual.data(), &out.J_camera, &J_general);
+  out.J_quadric = J_general.lazyProduct(classDefinition(c).basis);
   out.valid = out.residual.allFinite() && out.J_camera.allFinite() && out.J_quadric.allFinite();
   return out;
 }

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 
 #include "quadric_slam/geometry/quadric.h"
 #include "quadric_slam/geometry/se3.h"
@@ -46,11 +47,25 @@ class QuadricObservationCost : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // k <= 9: the per-evaluation matrices live on the stack (the cost is evaluated for every
+  // association pair and every window residual; heap traffic was a third of its cost).
+  using MatrixK6 = Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 9, 6>;
+  using MatrixK9 = Eigen::Matrix<double, Eigen::Dynamic, 9, Eigen::ColMajor, 9, 9>;
+  using MatrixKK = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 9, 9>;
+  // The residual (k) at the pose and quadric blocks, and when both pointers are given its
+  // Jacobians in the tangent spaces: w.r.t. the camera pose tangent (k x 6, = -L N Ad_{h^-1}) and
+  // the landmark's general tangent [rho; phi; s] (k x 9, = [L N, L M B^+_s]). Evaluate chains them
+  // with the blocks' MinusJacobians; the class's basis B maps the latter to its minimal tangent.
+  void evaluateTangent(double const* const* parameters, double* residuals, MatrixK6* J_camera,
+                       MatrixK9* J_general) const;
+
  private:
   QuadricModel z_;
   Eigen::Isometry3d T_quadric_camera_z_;  // z^-1
-  Eigen::MatrixXd sqrt_information_;      // L (k x k)
-  Eigen::MatrixXd basis_pinv_;            // B^+ (k x 9)
+  MatrixKK sqrt_information_;             // L (k x k)
+  MatrixK9 basis_pinv_;                   // B^+ (k x 9)
+  std::array<int, 6> dropped_{};          // the class's dropped pose components (P's rows)
+  int num_dropped_ = 0;
 };
 
 // Relative pose (odometry) factor between T_WCi and T_WCj with measurement T_ij~ = T_i^-1 T_j:

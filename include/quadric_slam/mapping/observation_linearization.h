@@ -12,11 +12,12 @@
 
 namespace quadric_slam {
 
+// k <= 9: fixed-capacity matrices (no heap; one is made for every association pair).
 struct ObservationLinearization {
-  Eigen::VectorXd residual;   // k
-  Eigen::MatrixXd J_camera;   // k x 6
-  Eigen::MatrixXd J_quadric;  // k x k
-  bool valid = false;         // false when the cost could not be evaluated (non-finite)
+  Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, 9, 1> residual;             // k
+  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::ColMajor, 9, 6> J_camera;             // k x 6
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 9, 9> J_quadric;  // k x k
+  bool valid = false;  // false when the cost could not be evaluated (non-finite)
 };
 
 // Throws std::invalid_argument when z and the landmark are of different classes.
