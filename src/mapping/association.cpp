@@ -9,17 +9,12 @@
 
 #include "quadric_slam/geometry/quadric_classes.h"
 #include "quadric_slam/mapping/observation_linearization.h"
+#include "quadric_slam/mapping/param_checks.h"
 #include "quadric_slam/mapping/surface_fusion.h"
 
 namespace quadric_slam {
 
 namespace {
-
-void requireRange(bool ok, const char* field, const char* range) {
-  if (!ok)
-    throw std::invalid_argument(std::string("QuadricAssociator::Params::") + field +
-                                " must be in " + range);
-}
 
 // Diagonal model-error floor in the class's minimal space (translation, rotation and scale
 // entries of Table II's minimal vector).
@@ -65,6 +60,7 @@ bool sameKind(const QuadricModel& a, const QuadricModel& b) {
 }
 
 void QuadricAssociator::Params::validate() const {
+  const ParamRangeCheck requireRange("QuadricAssociator::Params");
   requireRange(gate_probability > 0.0 && gate_probability < 1.0, "gate_probability", "(0, 1)");
   requireRange(floor_translation_sigma >= 0.0, "floor_translation_sigma", "[0, inf) m");
   requireRange(floor_rotation_sigma >= 0.0, "floor_rotation_sigma", "[0, inf) rad");

@@ -6,17 +6,12 @@
 #include <string>
 
 #include "quadric_slam/mapping/association.h"
+#include "quadric_slam/mapping/param_checks.h"
 #include "quadric_slam/mapping/surface_fusion.h"
 
 namespace quadric_slam {
 
 namespace {
-
-void requireRange(bool ok, const char* field, const char* range) {
-  if (!ok)
-    throw std::invalid_argument(std::string("LandmarkMerger::Params::") + field + " must be in " +
-                                range);
-}
 
 ExtentBox extentOf(const QuadricLandmark& landmark) {
   return ExtentBox{landmark.extent_min, landmark.extent_max};
@@ -33,6 +28,7 @@ Eigen::MatrixXd inverseOf(const Eigen::MatrixXd& spd) {
 }  // namespace
 
 void LandmarkMerger::Params::validate() const {
+  const ParamRangeCheck requireRange("LandmarkMerger::Params");
   requireRange(gate_probability > 0.0 && gate_probability < 1.0, "gate_probability", "(0, 1)");
   requireRange(floor_translation_sigma >= 0.0, "floor_translation_sigma", "[0, inf) m");
   requireRange(floor_rotation_sigma >= 0.0, "floor_rotation_sigma", "[0, inf) rad");

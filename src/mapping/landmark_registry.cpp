@@ -6,16 +6,11 @@
 #include <string>
 
 #include "quadric_slam/geometry/symmetry.h"
+#include "quadric_slam/mapping/param_checks.h"
 
 namespace quadric_slam {
 
 namespace {
-
-void requireRange(bool ok, const char* field, const char* range) {
-  if (!ok)
-    throw std::invalid_argument(std::string("LandmarkRegistry::Params::") + field + " must be in " +
-                                range);
-}
 
 ExtentBox landmarkExtent(const QuadricLandmark& landmark) {
   return ExtentBox{landmark.extent_min, landmark.extent_max};
@@ -37,6 +32,7 @@ ExtentBox observedExtentIn(const QuadricMeasurement& measurement,
 }  // namespace
 
 void LandmarkRegistry::Params::validate() const {
+  const ParamRangeCheck requireRange("LandmarkRegistry::Params");
   requireRange(min_observations >= 1 && min_observations <= 1000, "min_observations", "[1, 1000]");
   requireRange(candidate_timeout_frames >= 1 && candidate_timeout_frames <= 100000,
                "candidate_timeout_frames", "[1, 100000]");

@@ -7,20 +7,12 @@
 #include <string>
 
 #include "quadric_slam/geometry/quadric_class.h"
+#include "quadric_slam/mapping/param_checks.h"
 
 namespace quadric_slam {
 
-namespace {
-
-void requireRange(bool ok, const char* field, const char* range) {
-  if (!ok)
-    throw std::invalid_argument(std::string("MeasurementModelError::Params::") + field +
-                                " must be in " + range);
-}
-
-}  // namespace
-
 void MeasurementModelError::Params::validate() const {
+  const ParamRangeCheck requireRange("MeasurementModelError::Params");
   requireRange(std::isfinite(sigma) && sigma >= 0.0 && sigma <= 0.1, "sigma", "[0, 0.1] m");
   requireRange(
       std::isfinite(correlation_angle) && correlation_angle > 0.0 && correlation_angle <= 1.5,

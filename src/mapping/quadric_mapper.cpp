@@ -5,16 +5,11 @@
 #include <stdexcept>
 
 #include "quadric_slam/mapping/factors.h"
+#include "quadric_slam/mapping/param_checks.h"
 
 namespace quadric_slam {
 
 namespace {
-
-void requireRange(bool ok, const char* field, const char* range) {
-  if (!ok)
-    throw std::invalid_argument(std::string("QuadricMapper::Params::") + field + " must be in " +
-                                range);
-}
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -35,6 +30,7 @@ double rotationAngle(const Eigen::Isometry3d& T) {
 }  // namespace
 
 void QuadricMapper::Params::validate() const {
+  const ParamRangeCheck requireRange("QuadricMapper::Params");
   map.validate();
   window.validate();
   model_error.validate();

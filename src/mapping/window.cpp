@@ -13,6 +13,7 @@
 #include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/mapping/factors.h"
 #include "quadric_slam/mapping/observation_linearization.h"
+#include "quadric_slam/mapping/param_checks.h"
 #include "quadric_slam/mapping/solver_setup.h"
 #include "quadric_slam/mapping/surface_fusion.h"
 
@@ -24,15 +25,10 @@ using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::Ro
 using PoseBlock = std::array<double, kPoseParameterSize>;
 using QuadricBlock = std::array<double, kQuadricParameterSize>;
 
-void requireRange(bool ok, const char* field, const char* range) {
-  if (!ok)
-    throw std::invalid_argument(std::string("SlidingWindow::Params::") + field + " must be in " +
-                                range);
-}
-
 }  // namespace
 
 void SlidingWindow::Params::validate() const {
+  const ParamRangeCheck requireRange("SlidingWindow::Params");
   requireRange(size >= 2 && size <= 1000, "size", "[2, 1000]");
   requireRange(max_iterations >= 1 && max_iterations <= 1000, "max_iterations", "[1, 1000]");
   requireRange(observation_huber >= 0.0, "observation_huber", "[0, inf)");
