@@ -93,10 +93,14 @@ void PlaneRegionGrower::Params::validate() const {
               std::to_string(fill_max_normal_angle));
 }
 
-double kinectDepthSigma(double z, double noise_scale, double quantisation_factor) {
+double kinectDepthVariance(double z, double noise_scale, double quantisation_factor) {
   const double axial = noise_scale * (0.0012 + 0.0019 * (z - 0.4) * (z - 0.4));
   const double step = quantisation_factor * z * z;
-  return std::sqrt(axial * axial + step * step / 12.0);
+  return axial * axial + step * step / 12.0;
+}
+
+double kinectDepthSigma(double z, double noise_scale, double quantisation_factor) {
+  return std::sqrt(kinectDepthVariance(z, noise_scale, quantisation_factor));
 }
 
 double planePointThreshold(double z, const PlaneRegionGrower::Params& params) {
@@ -107,12 +111,8 @@ double planePointThreshold(double z, const PlaneRegionGrower::Params& params) {
 }
 
 double planePointVariance(double z, const PlaneRegionGrower::Params& params) {
-  // kinectDepthSigma squared, without its square root (called per point).
-  const double axial = params.noise_scale * (0.0012 + 0.0019 * (z - 0.4) * (z - 0.4));
-  const double z2 = z * z;
-  const double step = params.quantisation_factor * z2;
-  const double bend = params.bend_factor * z2;
-  return axial * axial + step * step / 12.0 + bend * bend;
+  const double bend = params.bend_factor * z * z;
+  return kinectDepthVariance(z, params.noise_scale, params.quantisation_factor) + bend * bend;
 }
 
 

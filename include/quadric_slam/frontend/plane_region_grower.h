@@ -27,6 +27,8 @@ inline double depthThreshold(double z, double factor, double min_distance) {
 // frames' plane residuals are about 1.4x the model), combined with the depth step of the disparity
 // quantisation (1/8 pixel: a step of quantisation_factor * z^2, uniform, std step / sqrt(12)).
 double kinectDepthSigma(double z, double noise_scale, double quantisation_factor);
+// Its square, without the square root (per-point noise sums).
+double kinectDepthVariance(double z, double noise_scale, double quantisation_factor);
 
 // Neighbouring Kinect depths share the disparity matcher's window: N grid points of one surface
 // carry about N / kCorrelatedDepthPoints independent measurements (plane and cell uncertainties).
