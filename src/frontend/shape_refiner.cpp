@@ -92,18 +92,6 @@ ShapeParameterJacobian shapeParameterJacobian(const QuadricModel& quadric) {
   return full * classDefinition(c).basis;
 }
 
-std::vector<Eigen::Vector3d> subsample(const std::vector<Eigen::Vector3d>& all_points,
-                                       int max_points) {
-  if (static_cast<int>(all_points.size()) <= max_points)
-    return all_points;
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(max_points);
-  const double step = static_cast<double>(all_points.size()) / max_points;
-  for (int i = 0; i < max_points; ++i)
-    points.push_back(all_points[static_cast<std::size_t>(i * step)]);
-  return points;
-}
-
 // The analytic Jacobian of the distances (not general): row i is base.distanceGradient(p_i)^T D.
 // The perturbation acts on the shape's core quadric, whose own (point, direction) may differ from
 // the shape's (e.g. a plane's point is the quadric origin offset * normal): base is that quadric's
@@ -190,7 +178,7 @@ ShapeRefiner::Result ShapeRefiner::refineUnchecked(
   if (static_cast<int>(all_points.size()) <= k || !validShape(initial))
     return result;
 
-  const std::vector<Eigen::Vector3d> points = subsample(all_points, params_.max_points);
+  const std::vector<Eigen::Vector3d> points = evenSubsample(all_points, params_.max_points);
 
   PrimitiveShape shape = initial;
   Eigen::VectorXd r = residuals(shape, points);
@@ -244,7 +232,7 @@ ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
       !validShape(shape))
     return result;
   try {
-    return covarianceOf(shape, subsample(all_points, params_.max_points), all_points.size());
+    return covarianceOf(shape, evenSubsample(all_points, params_.max_points), all_points.size());
   } catch (const std::invalid_argument&) {
     return result;
   }
@@ -262,6 +250,18 @@ Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
     J.row(static_cast<Eigen::Index>(i)).noalias() =
         chain.base.distanceGradient(points[i]).transpose().lazyProduct(chain.D);
   return J;
+}
+
+std::vector<Eigen::Vector3d> evenSubsample(const std::vector<Eigen::Vector3d>& all_points,
+                                           int max_points) {
+  if (static_cast<int>(all_points.size()) <= max_points)
+    return all_points;
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(max_points);
+  const double step = static_cast<double>(all_points.size()) / max_points;
+  for (int i = 0; i < max_points; ++i)
+    points.push_back(all_points[static_cast<std::size_t>(i * step)]);
+  return points;
 }
 
 PrimitiveShape fitPlane(const std::vector<Eigen::Vector3d>& points) {

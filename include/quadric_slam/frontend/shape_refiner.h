@@ -58,6 +58,11 @@ class ShapeRefiner {
 Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
                                  const std::vector<Eigen::Vector3d>& points);
 
+// At most max_points of all_points, evenly spaced in their order (all of them when there are no
+// more): on a segment's pixels in image order, an even spread over the surface patch.
+std::vector<Eigen::Vector3d> evenSubsample(const std::vector<Eigen::Vector3d>& all_points,
+                                           int max_points);
+
 // Total least-squares plane through points (PCA); normal oriented towards the origin (the camera)
 // and point = centroid. Requires >= 3 points.
 PrimitiveShape fitPlane(const std::vector<Eigen::Vector3d>& points);

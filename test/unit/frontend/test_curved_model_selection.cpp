@@ -1,0 +1,125 @@
+// Model selection among the curved classes (curved_model_selection.h) on noisy samples of the
+// visible side of a surface, started from the wrong class: a cone fitted as a cylinder becomes a
+// cone, a cylinder fitted as a cone becomes a cylinder, a sphere cap fitted as a cylinder becomes a
+// sphere, and a cylinder fitted as a cylinder stays one.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "quadric_slam/frontend/curved_model_selection.h"
+#include "quadric_slam/frontend/curved_shape_starts.h"
+
+namespace qs = quadric_slam;
+using qs::PrimitiveShape;
+using qs::QuadricClass;
+
+namespace {
+
+struct Samples {
+  std::vector<Eigen::Vector3d> points, normals;
+};
+
+const Eigen::Vector3d kAxisPoint(0.1, -0.3, 1.6);  // cone apex / cylinder axis point / sphere centre
+
+// The camera-facing part (azimuth within +-70 degrees of the camera direction) of a cone or a
+// cylinder with axis along y through kAxisPoint, heights y in [y_min, y_max], with Gaussian noise
+// along the normal.
+Samples axialSurface(bool cone, double radius_or_angle, double y_min, double y_max, double noise,
+                     unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, noise);
+  Samples s;
+  for (int i = 0; i < 1500; ++i) {
+    const double y = y_min + (y_max - y_min) * uni(rng);
+    const double a = (uni(rng) - 0.5) * 2 * 70 * M_PI / 180;
+    const Eigen::Vector3d radial(std::sin(a), 0, -std::cos(a));
+    const double r = cone ? y * std::tan(radius_or_angle) : radius_or_angle;
+    const Eigen::Vector3d n = cone ? Eigen::Vector3d(std::cos(radius_or_angle) * radial -
+                                                     std::sin(radius_or_angle) * Eigen::Vector3d::UnitY())
+                                   : radial;
+    s.points.push_back(kAxisPoint + y * Eigen::Vector3d::UnitY() + r * radial + gauss(rng) * n);
+    s.normals.push_back(n.normalized());
+  }
+  return s;
+}
+
+// A cap of a sphere facing the camera (polar angle from -z within 60 degrees).
+Samples sphereCap(double radius, double noise, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, noise);
+  Samples s;
+  for (int i = 0; i < 1500; ++i) {
+    const double polar = std::acos(1 - uni(rng) * (1 - std::cos(60 * M_PI / 180)));
+    const double azimuth = 2 * M_PI * uni(rng);
+    const Eigen::Vector3d n(std::sin(polar) * std::cos(azimuth),
+                            std::sin(polar) * std::sin(azimuth), -std::cos(polar));
+    s.points.push_back(kAxisPoint + (radius + gauss(rng)) * n);
+    s.normals.push_back(n);
+  }
+  return s;
+}
+
+qs::QuadricSegmenter::Params params() {
+  qs::QuadricSegmenter::Params p;
+  p.detect_cones = true;
+  p.detect_spheres = true;
+  return p;
+}
+
+// The refined fit of start's class on the samples, then model selection.
+qs::ShapeRefiner::Result selected(const PrimitiveShape& start, const Samples& s) {
+  const qs::ShapeRefiner refiner;
+  const qs::ShapeRefiner::Result fit = refiner.refine(start, s.points);
+  return qs::selectCurvedModel(fit, s.points, s.normals, params(), refiner);
+}
+
+}  // namespace
+
+TEST(CurvedModelSelection, ConeFittedAsCylinderBecomesCone) {
+  const double half_angle = 0.3;
+  const Samples s = axialSurface(true, half_angle, 0.2, 0.5, 0.001, 1);
+  const PrimitiveShape start = qs::cylinderFromCone(
+      PrimitiveShape::cone(kAxisPoint, Eigen::Vector3d::UnitY(), half_angle), s.points);
+  const qs::ShapeRefiner::Result result = selected(start, s);
+  ASSERT_EQ(result.shape.quadric_class, QuadricClass::kCone);
+  EXPECT_NEAR(result.shape.size, half_angle, 0.01);
+  EXPECT_LT(result.rms, 0.0012);
+}
+
+TEST(CurvedModelSelection, CylinderFittedAsConeBecomesCylinder) {
+  const double radius = 0.06;
+  const Samples s = axialSurface(false, radius, -0.15, 0.15, 0.001, 2);
+  // A thin cone around the cylinder: apex far down the axis.
+  const double height = 3.0;
+  const PrimitiveShape start =
+      PrimitiveShape::cone(kAxisPoint - height * Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitY(),
+                           std::atan(radius / height));
+  const qs::ShapeRefiner::Result result = selected(start, s);
+  ASSERT_EQ(result.shape.quadric_class, QuadricClass::kCylinder);
+  EXPECT_NEAR(result.shape.size, radius, 0.002);
+}
+
+TEST(CurvedModelSelection, SphereCapFittedAsCylinderBecomesSphere) {
+  const double radius = 0.1;
+  const Samples s = sphereCap(radius, 0.001, 3);
+  const PrimitiveShape start =
+      PrimitiveShape::cylinder(kAxisPoint, Eigen::Vector3d::UnitY(), radius);
+  const qs::ShapeRefiner::Result result = selected(start, s);
+  ASSERT_EQ(result.shape.quadric_class, QuadricClass::kSphere);
+  EXPECT_NEAR(result.shape.size, radius, 0.002);
+  EXPECT_LT((result.shape.point - kAxisPoint).norm(), 0.003);
+}
+
+TEST(CurvedModelSelection, CylinderStaysCylinder) {
+  const double radius = 0.05;
+  const Samples s = axialSurface(false, radius, -0.2, 0.2, 0.001, 4);
+  const PrimitiveShape start =
+      PrimitiveShape::cylinder(kAxisPoint, Eigen::Vector3d::UnitY(), radius * 1.1);
+  const qs::ShapeRefiner::Result result = selected(start, s);
+  ASSERT_EQ(result.shape.quadric_class, QuadricClass::kCylinder);
+  EXPECT_NEAR(result.shape.size, radius, 0.001);
+  EXPECT_LT(result.rms, 0.0012);
+}
