@@ -59,23 +59,60 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
     std::vector<Eigen::Vector3d> lo, hi;
     std::vector<ImageRoi> box;  // x, y min; width, height = max
   };
-  const int threads = std::max(1, std::min(p.threads, height));
+  // Rows are split over the threads by blocks of d rows: the d x d full-resolution pixels of a
+  // block share their four neighbouring coarse samples, read once.
+  const int block_rows = (height + d - 1) / d;
+  const int threads = std::max(1, std::min(p.threads, block_rows));
   std::vector<Tally> tallies(threads);
   const int cw = coarse.labels.cols, ch = coarse.labels.rows;
-  forEachChunk(height, threads, [&](int chunk, int v_begin, int v_end) {
+  forEachChunk(block_rows, threads, [&](int chunk, int block_row_begin, int block_row_end) {
     Tally& tally = tallies[chunk];
     tally.count.assign(n, 0);
     tally.sum_sq.assign(n, 0.0);
     tally.lo.assign(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
     tally.hi.assign(n, Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
     tally.box.assign(n, ImageRoi{width, height, -1, -1});
-    const int blocks = (width + d - 1) / d;
-    for (int v = v_begin; v < v_end; ++v) {
-      const int cv0 = std::min(v / d, ch - 1), cv1 = std::min(v / d + 1, ch - 1);
-      const std::uint16_t* row0 = coarse.labels.ptr<std::uint16_t>(cv0);
-      const std::uint16_t* row1 = coarse.labels.ptr<std::uint16_t>(cv1);
-      // The d pixels of a row in one block share their four neighbouring coarse samples.
-      for (int b = 0; b < blocks; ++b) {
+    // Labels pixel (u, v) with the best of the distinct candidate labels, if any fits.
+    const auto labelPixel = [&](int u, int v, const std::uint16_t* labels, int distinct,
+                                bool single_surface, std::uint16_t* label_row) {
+      const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
+      if (!validPoint(q, p))
+        return;
+      const Eigen::Vector3d point = pointOf(q);
+      int best = 0;
+      double best_distance = depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
+      for (int c = 0; c < distinct; ++c) {
+        const int label = labels[c];
+        const PrimitiveShape& shape = coarse.detections[label - 1].shape;
+        const double distance = std::abs(shape.distance(point));
+        if (distance >= best_distance)
+          continue;
+        if ((!single_surface || distance > noise_gate[label - 1]) &&
+            std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
+          continue;
+        best = label;
+        best_distance = distance;
+      }
+      if (best == 0)
+        return;
+      label_row[u] = static_cast<std::uint16_t>(best);
+      const int k = best - 1;
+      ++tally.count[k];
+      tally.sum_sq[k] += best_distance * best_distance;
+      const Eigen::Vector3d local = T_quadric_camera[k] * point;
+      tally.lo[k] = tally.lo[k].cwiseMin(local);
+      tally.hi[k] = tally.hi[k].cwiseMax(local);
+      ImageRoi& box = tally.box[k];
+      box.x_offset = std::min(box.x_offset, u);
+      box.y_offset = std::min(box.y_offset, v);
+      box.width = std::max(box.width, u);
+      box.height = std::max(box.height, v);
+    };
+    for (int j = block_row_begin; j < block_row_end; ++j) {
+      const std::uint16_t* row0 = coarse.labels.ptr<std::uint16_t>(std::min(j, ch - 1));
+      const std::uint16_t* row1 = coarse.labels.ptr<std::uint16_t>(std::min(j + 1, ch - 1));
+      const int v_end = std::min(height, (j + 1) * d);
+      for (int b = 0; b * d < width; ++b) {
         const int cu0 = std::min(b, cw - 1), cu1 = std::min(b + 1, cw - 1);
         const std::uint16_t candidates[4] = {row0[cu0], row0[cu1], row1[cu0], row1[cu1]};
         if ((candidates[0] | candidates[1] | candidates[2] | candidates[3]) == 0)
@@ -85,55 +122,18 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
         // points do (within kNoiseGate x the fit's RMS): its normal is the noisiest evidence
         // there (at 3-4 m the normals of a flat wall scatter beyond the normal tolerance, which
         // left holes all over far surfaces). Other pixels, and all between two labelled
-        // surfaces, need the normal to agree as well.
-        std::uint16_t only = 0;
-        bool single_surface = true;
-        for (const std::uint16_t label : candidates) {
-          if (label == 0 || label == only)
-            continue;
-          single_surface = only == 0;
-          only = label;
-        }
-        // Each surface measured once per pixel.
+        // surfaces, need the normal to agree as well. Each surface is measured once per pixel.
         std::uint16_t labels[4];
         int distinct = 0;
         for (const std::uint16_t label : candidates)
           if (label != 0 && std::find(labels, labels + distinct, label) == labels + distinct)
             labels[distinct++] = label;
-        for (int u = b * d; u < std::min(width, (b + 1) * d); ++u) {
-          const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
-          if (!validPoint(q, p))
-            continue;
-          const Eigen::Vector3d point = pointOf(q);
-          int best = 0;
-          double best_distance =
-              depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
-          for (int c = 0; c < distinct; ++c) {
-            const int label = labels[c];
-            const PrimitiveShape& shape = coarse.detections[label - 1].shape;
-            const double distance = std::abs(shape.distance(point));
-            if (distance >= best_distance)
-              continue;
-            if ((!single_surface || distance > noise_gate[label - 1]) &&
-                std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
-              continue;
-            best = label;
-            best_distance = distance;
-          }
-          if (best == 0)
-            continue;
-          result.labels.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(best);
-          const int k = best - 1;
-          ++tally.count[k];
-          tally.sum_sq[k] += best_distance * best_distance;
-          const Eigen::Vector3d local = T_quadric_camera[k] * point;
-          tally.lo[k] = tally.lo[k].cwiseMin(local);
-          tally.hi[k] = tally.hi[k].cwiseMax(local);
-          ImageRoi& box = tally.box[k];
-          box.x_offset = std::min(box.x_offset, u);
-          box.y_offset = std::min(box.y_offset, v);
-          box.width = std::max(box.width, u);
-          box.height = std::max(box.height, v);
+        const bool single_surface = distinct == 1;
+        const int u_end = std::min(width, (b + 1) * d);
+        for (int v = j * d; v < v_end; ++v) {
+          std::uint16_t* label_row = result.labels.ptr<std::uint16_t>(v);
+          for (int u = b * d; u < u_end; ++u)
+            labelPixel(u, v, labels, distinct, single_surface, label_row);
         }
       }
     }
@@ -179,11 +179,11 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
                              box[k].height - box[k].y_offset + 1};
     result.detections.push_back(std::move(detection));
   }
-  for (int v = 0; v < height; ++v)
-    for (int u = 0; u < width; ++u) {
-      std::uint16_t& label = result.labels.at<std::uint16_t>(v, u);
-      label = relabel[label];
-    }
+  for (int v = 0; v < height; ++v) {
+    std::uint16_t* row = result.labels.ptr<std::uint16_t>(v);
+    for (int u = 0; u < width; ++u)
+      row[u] = relabel[row[u]];
+  }
   return result;
 }
 
