@@ -152,8 +152,8 @@ double PrimitiveShape::curvedDistance(const Eigen::Vector3d& p) const {
     default: {
       // First-order distance f / |grad f| (Sampson); the floor keeps points at the centre, where
       // the gradient vanishes, finite and far.
-      const double f = algebraicDistance(general_quadric, p);
-      return f / std::max(algebraicGradient(general_quadric, p).norm(), 1e-9);
+      const AlgebraicValue a = algebraicValueAndSlope(general_quadric, p);
+      return a.value / std::max(a.gradient_norm, 1e-9);
     }
   }
 }

@@ -10,7 +10,8 @@ namespace quadric_slam {
 namespace {
 
 Eigen::Vector3d toQuadric(const QuadricModel& q, const Eigen::Vector3d& p) {
-  return q.pose().inverse() * p;
+  const Eigen::Isometry3d& T = q.pose();
+  return T.linear().transpose() * (p - T.translation());
 }
 
 // Closest point on a (double) cone with apex at the origin, axis z and half-angle theta, in the
@@ -49,9 +50,19 @@ Eigen::Vector3d algebraicGradient(const QuadricModel& q, const Eigen::Vector3d& 
   return q.pose().linear() * local;
 }
 
+AlgebraicValue algebraicValueAndSlope(const QuadricModel& q, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d s = q.scale();
+  const Eigen::Vector3d sigma = q.signature().head<3>();
+  const Eigen::Vector3d y = s.cwiseProduct(toQuadric(q, p));
+  AlgebraicValue result;
+  result.value = y.dot(sigma.cwiseProduct(y)) + q.signature()[3];
+  result.gradient_norm = 2.0 * s.cwiseProduct(sigma.cwiseProduct(y)).norm();
+  return result;
+}
+
 double firstOrderDistance(const QuadricModel& q, const Eigen::Vector3d& p) {
-  const double f = algebraicDistance(q, p);
-  const double g = algebraicGradient(q, p).norm();
+  const AlgebraicValue a = algebraicValueAndSlope(q, p);
+  const double f = a.value, g = a.gradient_norm;
   if (f == 0)
     return 0;
   if (g == 0)

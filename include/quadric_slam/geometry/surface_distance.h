@@ -13,6 +13,13 @@ namespace quadric_slam {
 double algebraicDistance(const QuadricModel& quadric, const Eigen::Vector3d& p);
 // grad f in the quadric's frame: 2 R S D(sigma_1..3) S p_Q.
 Eigen::Vector3d algebraicGradient(const QuadricModel& quadric, const Eigen::Vector3d& p);
+// f(p) and |grad f(p)| at once, with a single change of frame (the gradient's norm needs no rotation
+// back): what a Sampson distance f / |grad f| needs per point, at a fraction of the two calls above.
+struct AlgebraicValue {
+  double value = 0.0;          // f(p)
+  double gradient_norm = 0.0;  // |grad f(p)|
+};
+AlgebraicValue algebraicValueAndSlope(const QuadricModel& quadric, const Eigen::Vector3d& p);
 // First-order geometric distance |f| / |grad f| (infinite where grad f = 0 off the surface; 0 on
 // it). Exact to first order near a surface whose f vanishes to first order; for the double plane
 // (alpha x)^2 = 0, f vanishes to second order and this gives half the true distance.

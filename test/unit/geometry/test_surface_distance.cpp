@@ -79,6 +79,23 @@ TEST(SurfaceProjector, ProjectsOntoTheClosestSurfacePoint) {
   }
 }
 
+TEST(SurfaceDistance, ValueAndSlopeAgreeWithValueAndGradient) {
+  std::mt19937 rng(85);
+  for (const QuadricClass c : {QuadricClass::kGeneral, QuadricClass::kCylinder, QuadricClass::kCone,
+                               QuadricClass::kSphere}) {
+    const QuadricModel q = test::randomQuadric(c, rng);
+    for (int i = 0; i < 20; ++i) {
+      const Eigen::Vector3d p = q.pose() * test::randomVector(rng, 1.0);
+      const AlgebraicValue a = algebraicValueAndSlope(q, p);
+      const double f = algebraicDistance(q, p);
+      const double g = algebraicGradient(q, p).norm();
+      EXPECT_NEAR(a.value, f, 1e-12 * std::max(1.0, std::abs(f)));
+      EXPECT_NEAR(a.gradient_norm, g, 1e-12 * std::max(1.0, g));
+      EXPECT_GT(g, 0.0);
+    }
+  }
+}
+
 TEST(SurfaceProjector, GeneralQuadricsConvergeToTheSurface) {
   std::mt19937 rng(84);
   SurfaceProjector projector;
