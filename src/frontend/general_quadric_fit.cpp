@@ -101,17 +101,18 @@ GeneralQuadricFit fitGeneralQuadric(const std::vector<Eigen::Vector3d>& all_poin
   double cost = r.squaredNorm();
   double lambda = 1e-3;
   for (int it = 0; it < iterations; ++it) {
-    Eigen::MatrixXd J(x.size(), 10);
+    // J^T J and J^T r accumulated row by row in fixed-size matrices (no n x 10 Jacobian).
+    Eigen::Matrix<double, 10, 10> H = Eigen::Matrix<double, 10, 10>::Zero();
+    Vector10d g = Vector10d::Zero();
     for (std::size_t i = 0; i < x.size(); ++i) {
       Vector10d row;
       sampsonDistance(c, x[i], &row);
-      J.row(static_cast<Eigen::Index>(i)) = row.transpose();
+      H.noalias() += row * row.transpose();
+      g += row * r[static_cast<Eigen::Index>(i)];
     }
-    const Eigen::MatrixXd H = J.transpose() * J;
-    const Eigen::VectorXd g = J.transpose() * r;
     bool improved = false;
     for (int attempt = 0; attempt < 6 && !improved; ++attempt) {
-      Eigen::MatrixXd A = H;
+      Eigen::Matrix<double, 10, 10> A = H;
       A.diagonal() += lambda * H.diagonal().cwiseMax(1e-12);
       Vector10d candidate = c + A.ldlt().solve(-g);
       if (!candidate.allFinite())
