@@ -3,11 +3,13 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
 #include "quadric_slam/geometry/quadric_classes.h"
+#include "quadric_slam/mapping/measurement_model_error.h"
 #include "quadric_slam/mapping/observation_linearization.h"
 #include "quadric_slam/mapping/param_checks.h"
 #include "quadric_slam/mapping/surface_fusion.h"
@@ -67,6 +69,10 @@ void QuadricAssociator::Params::validate() const {
   requireRange(floor_scale_fraction >= 0.0, "floor_scale_fraction", "[0, inf)");
   requireRange(pose_translation_sigma >= 0.0, "pose_translation_sigma", "[0, inf) m");
   requireRange(pose_rotation_sigma >= 0.0, "pose_rotation_sigma", "[0, inf) rad");
+  requireRange(correlated_noise_fraction >= 0.0 && correlated_noise_fraction <= 1.0,
+               "correlated_noise_fraction", "[0, 1]");
+  requireRange(noise_correlation_angle > 0.0 && noise_correlation_angle <= 0.5,
+               "noise_correlation_angle", "(0, 0.5] rad");
   requireRange(extent_margin >= 0.0, "extent_margin", "[0, inf) m");
   requireRange(max_range > 0.0, "max_range", "(0, inf) m");
 }
@@ -80,6 +86,26 @@ QuadricAssociator::QuadricAssociator(const Params& params) : params_(params) {
 
 double QuadricAssociator::gate(QuadricClass quadric_class) const {
   return gates_.at(static_cast<int>(quadric_class));
+}
+
+double QuadricAssociator::correlatedNoiseFactor(const QuadricMeasurement& measurement) const {
+  const double f = params_.correlated_noise_fraction;
+  const double n = static_cast<double>(measurement.num_points);
+  if (f == 0.0 || n < 2.0 || measurement.quadric_camera.quadricClass() == QuadricClass::kGeneral)
+    return 1.0;
+  Eigen::Vector3d sides = (measurement.extent_max - measurement.extent_min).cwiseAbs();
+  if (!sides.allFinite() || sides.maxCoeff() <= 0.0)
+    return 1.0;
+  std::sort(sides.data(), sides.data() + 3, std::greater<double>());
+  // The support's area: its box's two largest sides (the surface's extent, not its thickness).
+  const double cell = params_.noise_correlation_angle * MeasurementModelError::supportDepth(measurement);
+  const double cells = std::clamp(sides[0] * sides[1] / (cell * cell), 1.0, n);
+  return 1.0 + f * (n / cells - 1.0);
+}
+
+Eigen::MatrixXd QuadricAssociator::associationCovariance(
+    const QuadricMeasurement& measurement) const {
+  return measurement.covariance * correlatedNoiseFactor(measurement);
 }
 
 double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
@@ -110,7 +136,8 @@ double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
   const double st = params_.pose_translation_sigma, sr = params_.pose_rotation_sigma;
   P.diagonal() += (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr).finished();
   const MatrixK6 J_c_P = J_c.lazyProduct(P);
-  MatrixKK S = measurement.covariance + floorCovariance(params_, target.quadric_map);
+  MatrixKK S = measurement.covariance * correlatedNoiseFactor(measurement) +
+               floorCovariance(params_, target.quadric_map);
   S += J_c_P.lazyProduct(J_c.transpose());
   if (target.covariance.size() != 0) {
     const MatrixKK J_q_C = J_q.lazyProduct(target.covariance);

@@ -73,6 +73,8 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
   readParam(reader, "floor_scale_fraction", association.floor_scale_fraction, log);
   readParam(reader, "pose_translation_sigma", association.pose_translation_sigma, log);
   readParam(reader, "pose_rotation_sigma", association.pose_rotation_sigma, log);
+  readParam(reader, "correlated_noise_fraction", association.correlated_noise_fraction, log);
+  readParam(reader, "noise_correlation_angle", association.noise_correlation_angle, log);
   readParam(reader, "check_extent", association.check_extent, log);
   readParam(reader, "extent_margin", association.extent_margin, log);
   readParam(reader, "association_max_range", association.max_range, log);

@@ -15,6 +15,20 @@
 // landmark's marginal covariance when known; Sigma_floor = a model-error floor in the minimal space
 // (translation entries, rotation entries, and scale entries relative to the target's scale).
 //
+// Sigma_z counts the depth noise of the n supporting points as independent. A depth camera's noise
+// is not: a structured-light camera matches its pattern over a window of pixels, so most of its
+// noise is shared by neighbouring pixels over a cell of about noise_correlation_angle seen from
+// the camera. Over a support of area A at depth z that share averages over the
+// n_c = clamp(A / (noise_correlation_angle z)^2, 1, n) cells the support covers, not over its n
+// points, so the fit's covariance rms^2 (J^T J)^-1 understates it by n / n_c along the fit's own
+// directions; the gate uses
+//   Sigma_z' = Sigma_z (1 + f (n / n_c - 1)),     f = correlated_noise_fraction,
+// (the least-squares covariance of a noise whose share f is correlated over cells). This matters
+// most along a fit's weak direction: a band of a cone seen from one side fixes the radius where it
+// is seen but hardly how it splits into half-angle, apex height along the axis and axis tilt, and
+// that combination scatters from frame to frame far beyond what n independent points would allow.
+// A candidate (one measurement) carries the same covariance (associationCovariance).
+//
 // Extents: a match must also let the observed box of supporting points (moved into the target's
 // quadric frame through the predicted pose) overlap the target's box, grown by extent_margin: a
 // second table top at the same height is the same infinite plane, but not the same surface.
@@ -71,6 +85,12 @@ class QuadricAssociator {
     // pose error at the 99.9% gate.
     double pose_translation_sigma = 0.03;
     double pose_rotation_sigma = 0.02;
+    // The depth noise's spatially correlated share f ([0, 1]; 0 treats the points as independent)
+    // and the angle over which it is correlated, seen from the camera (rad, (0, 0.5]): see above.
+    // The defaults are those of the Kinect v1 model calibrated on real frames (85% of the noise
+    // variance low-passed over 4 px, a cell of 2 sqrt(pi) 4 px ~ 14 px at f = 580 px).
+    double correlated_noise_fraction = 0.85;
+    double noise_correlation_angle = 0.025;
     // Reject matches whose extents (grown by extent_margin, m, >= 0) do not overlap.
     bool check_extent = true;
     double extent_margin = 0.25;
@@ -95,6 +115,13 @@ class QuadricAssociator {
   // covariance has the wrong size or is not positive definite.
   double squaredError(const QuadricMeasurement& measurement, const Eigen::Isometry3d& T_map_camera,
                       const Matrix6d& pose_covariance, const AssociationTarget& target) const;
+
+  // The measurement's covariance as the gate uses it (Sigma_z' above; the general class, whose
+  // covariance already holds the segmenter's model error, and measurements without points or
+  // extent keep Sigma_z).
+  Eigen::MatrixXd associationCovariance(const QuadricMeasurement& measurement) const;
+  // The factor 1 + f (n / n_c - 1) of Sigma_z' (1 when it does not apply).
+  double correlatedNoiseFactor(const QuadricMeasurement& measurement) const;
 
   // False when the box `extent` (in the frame of quadric_map) is known and farther than max_range
   // from the camera centre: such a target is not compared (callers may skip building it).
