@@ -150,6 +150,33 @@ TEST(PipelineParams, ModelErrorKeysAreReadAndValidated) {
   }
 }
 
+// The gate's correlated depth noise (mapping/association.h): the file's values reach the
+// associator, and a value out of range is refused naming the field.
+TEST(PipelineParams, CorrelatedNoiseKeysAreReadAndValidated) {
+  const YAML::Node file = YAML::LoadFile(kConfigDir + "mapping.yaml");
+  qs::QuadricMapper::Params mapper;
+  qs::QuadricReconstruction::Params reconstruction;
+  qs::ParamLog log;
+  qs::readMappingParams(qs::YamlParamReader(file), mapper, reconstruction, log);
+  EXPECT_DOUBLE_EQ(mapper.map.association.correlated_noise_fraction,
+                   file["correlated_noise_fraction"].as<double>());
+  EXPECT_DOUBLE_EQ(mapper.map.association.noise_correlation_angle,
+                   file["noise_correlation_angle"].as<double>());
+  for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
+           {"{correlated_noise_fraction: 1.01}", "correlated_noise_fraction"},
+           {"{correlated_noise_fraction: -0.1}", "correlated_noise_fraction"},
+           {"{noise_correlation_angle: 0}", "noise_correlation_angle"},
+           {"{noise_correlation_angle: 0.6}", "noise_correlation_angle"}}) {
+    qs::QuadricMapper::Params fresh;
+    try {
+      qs::readMappingParams(qs::YamlParamReader(YAML::Load(bad)), fresh, reconstruction, log);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  }
+}
+
 // Off unless a file turns it on; a bad iteration count is refused naming the field.
 TEST(PipelineParams, BatchRefinementKeysAreValidated) {
   bool enabled = false;
