@@ -113,7 +113,7 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
           candidate.extent.transformed(aligned.pose().inverse() * candidate.quadric_map.pose())
               .merged(observedExtentIn(measurement, T_map_camera, aligned));
       candidate.quadric_map = aligned;
-      candidate.covariance = M * associator_.associationCovariance(measurement) * M.transpose();
+      candidate.covariance = M * measurement.covariance * M.transpose();
       candidate.observations += 1;
       candidate.last_frame = frame_index;
       candidate.last_observed = stamp;
@@ -126,7 +126,7 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
       QuadricCandidate candidate;
       candidate.id = next_candidate_id_++;
       candidate.quadric_map = moved;
-      candidate.covariance = associator_.associationCovariance(measurement);
+      candidate.covariance = measurement.covariance;
       candidate.extent = observed;
       candidate.observations = 1;
       candidate.last_frame = frame_index;

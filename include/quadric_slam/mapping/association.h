@@ -27,7 +27,8 @@
 // most along a fit's weak direction: a band of a cone seen from one side fixes the radius where it
 // is seen but hardly how it splits into half-angle, apex height along the axis and axis tilt, and
 // that combination scatters from frame to frame far beyond what n independent points would allow.
-// A candidate (one measurement) carries the same covariance (associationCovariance).
+// (A candidate keeps its measurement's Sigma_z: inflating it too let more one-off detections of a
+// real room reach five observations, 130 -> 143 landmarks on the first 300 kitchen frames.)
 //
 // Extents: a match must also let the observed box of supporting points (moved into the target's
 // quadric frame through the predicted pose) overlap the target's box, grown by extent_margin: a

@@ -34,9 +34,7 @@ struct CandidateObservation {
 struct QuadricCandidate {
   int id = 0;                  // candidate id (own counter; never a landmark id)
   QuadricModel quadric_map;    // the latest measurement moved into the map at its predicted pose
-  // That measurement's covariance as the associator's gate sees it (associationCovariance: the
-  // depth noise's correlated share counted per cell; body tangents are invariant).
-  Eigen::MatrixXd covariance;
+  Eigen::MatrixXd covariance;  // that measurement's covariance (body tangents are invariant)
   ExtentBox extent;            // union of the observed boxes, in quadric_map's frame
   int observations = 0;        // frames that saw it
   int last_frame = 0;          // frame index of the latest
