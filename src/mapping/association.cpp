@@ -91,7 +91,8 @@ double QuadricAssociator::gate(QuadricClass quadric_class) const {
 double QuadricAssociator::correlatedNoiseFactor(const QuadricMeasurement& measurement) const {
   const double f = params_.correlated_noise_fraction;
   const double n = static_cast<double>(measurement.num_points);
-  if (f == 0.0 || n < 2.0 || measurement.quadric_camera.quadricClass() == QuadricClass::kGeneral)
+  const QuadricClass c = measurement.quadric_camera.quadricClass();
+  if (f == 0.0 || n < 2.0 || c == QuadricClass::kGeneral || c == QuadricClass::kPlane)
     return 1.0;
   Eigen::Vector3d sides = (measurement.extent_max - measurement.extent_min).cwiseAbs();
   if (!sides.allFinite() || sides.maxCoeff() <= 0.0)

@@ -252,5 +252,28 @@ TEST(QuadricAssociator, OneToOne) {
   EXPECT_EQ(a[0].outcome, AssociationOutcome::kTakenByBetter);
 }
 
+// The correlated-noise scaling of the gate (correlated_noise_fraction) widens curved surfaces'
+// gates, by more for a larger support; a plane's and a general quadric's covariance stay as measured.
+TEST(QuadricAssociator, CorrelatedNoiseScalesCurvedSurfacesOnly) {
+  std::mt19937 rng(12);
+  const QuadricAssociator associator;
+  const test::TrueLandmark cylinder =
+      test::cylinder(Eigen::Vector3d(0, 0, 0.5), Eigen::Vector3d::UnitZ(), 0.15, 0.5);
+  QuadricMeasurement m = test::measure(cylinder, kTrueCamera, rng);
+  const double factor = associator.correlatedNoiseFactor(m);
+  EXPECT_GT(factor, 1.5);
+  m.num_points *= 4;  // the same area with more points: more points per correlation cell
+  EXPECT_GT(associator.correlatedNoiseFactor(m), factor);
+  QuadricAssociator::Params independent;
+  independent.correlated_noise_fraction = 0.0;
+  EXPECT_EQ(QuadricAssociator(independent).correlatedNoiseFactor(m), 1.0);
+
+  const test::TrueLandmark wall = test::plane(Eigen::Vector3d(0, 0.8, 0.75),
+                                              Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitX(), 1.0, 1.0);
+  const QuadricMeasurement of_wall = test::measure(wall, kTrueCamera, rng);
+  EXPECT_EQ(associator.correlatedNoiseFactor(of_wall), 1.0);
+  EXPECT_TRUE(associator.associationCovariance(of_wall).isApprox(of_wall.covariance));
+}
+
 }  // namespace
 }  // namespace quadric_slam
