@@ -128,7 +128,8 @@ class QuadricSegmenter {
     // better than that of a simpler class (cone -> cylinder -> sphere; RMS of the simpler <
     // cylinder_rms_ratio * its own) becomes the simpler class. Ratios >= 1.
     // A cylinder is also fitted as a cone (a truncated cone with a small half angle looks like a
-    // cylinder) and becomes one when the cone's RMS is below its own / cylinder_rms_ratio.
+    // cylinder) and becomes one when the cone's RMS is below its own / cylinder_rms_ratio or the
+    // cone is significantly better over the independent points (curved_model_selection.h).
     double plane_rms_ratio = 1.5;
     double cylinder_rms_ratio = 1.15;
     // Shape test: a curved fit whose RMS exceeds quadric_rms_ratio times that of a general quadric
