@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "axial_surface_samples.h"
 #include "quadric_slam/frontend/curved_model_selection.h"
 #include "quadric_slam/frontend/curved_shape_starts.h"
 
@@ -16,33 +17,13 @@ using qs::QuadricClass;
 
 namespace {
 
-struct Samples {
-  std::vector<Eigen::Vector3d> points, normals;
-};
+using Samples = qs::test::SurfaceSamples;
+using qs::test::kAxisPoint;
 
-const Eigen::Vector3d kAxisPoint(0.1, -0.3, 1.6);  // cone apex / cylinder axis point / sphere centre
-
-// The camera-facing part (azimuth within +-70 degrees of the camera direction) of a cone or a
-// cylinder with axis along y through kAxisPoint, heights y in [y_min, y_max], with Gaussian noise
-// along the normal.
+// 1500 points of the camera-facing part (azimuth within +-70 degrees) of a cone or cylinder.
 Samples axialSurface(bool cone, double radius_or_angle, double y_min, double y_max, double noise,
                      unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  std::normal_distribution<double> gauss(0.0, noise);
-  Samples s;
-  for (int i = 0; i < 1500; ++i) {
-    const double y = y_min + (y_max - y_min) * uni(rng);
-    const double a = (uni(rng) - 0.5) * 2 * 70 * M_PI / 180;
-    const Eigen::Vector3d radial(std::sin(a), 0, -std::cos(a));
-    const double r = cone ? y * std::tan(radius_or_angle) : radius_or_angle;
-    const Eigen::Vector3d n = cone ? Eigen::Vector3d(std::cos(radius_or_angle) * radial -
-                                                     std::sin(radius_or_angle) * Eigen::Vector3d::UnitY())
-                                   : radial;
-    s.points.push_back(kAxisPoint + y * Eigen::Vector3d::UnitY() + r * radial + gauss(rng) * n);
-    s.normals.push_back(n.normalized());
-  }
-  return s;
+  return qs::test::axialSurface(cone, radius_or_angle, y_min, y_max, noise, seed, 1500, 70.0);
 }
 
 // A cap of a sphere facing the camera (polar angle from -z within 60 degrees).

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "axial_surface_samples.h"
 #include "quadric_slam/frontend/curved_shape_starts.h"
 
 namespace qs = quadric_slam;
@@ -13,35 +14,8 @@ using qs::PrimitiveShape;
 
 namespace {
 
-struct Samples {
-  std::vector<Eigen::Vector3d> points, normals;
-};
-
-// The camera-facing half (azimuth within +-80 degrees of the camera direction) of a cone or a
-// cylinder with axis along y at (x0, *, z0), heights y in [y_min, y_max]; normals out of the
-// surface, with optional Gaussian noise on the points.
-Samples axialSurface(bool cone, double radius_or_angle, double y_min, double y_max, double noise,
-                     unsigned seed) {
-  const Eigen::Vector3d apex(0.1, -0.3, 1.6);  // cone apex / a point on the cylinder's axis
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  std::normal_distribution<double> gauss(0.0, noise);
-  Samples s;
-  for (int i = 0; i < 800; ++i) {
-    const double y = y_min + (y_max - y_min) * uni(rng);
-    // Azimuth measured from -z (towards the camera at the origin).
-    const double a = (uni(rng) - 0.5) * 2 * 80 * M_PI / 180;
-    const Eigen::Vector3d radial(std::sin(a), 0, -std::cos(a));
-    const double r = cone ? y * std::tan(radius_or_angle) : radius_or_angle;
-    const Eigen::Vector3d axial = Eigen::Vector3d::UnitY();
-    Eigen::Vector3d n = cone ? Eigen::Vector3d(std::cos(radius_or_angle) * radial -
-                                               std::sin(radius_or_angle) * axial)
-                             : radial;
-    s.points.push_back(apex + y * axial + r * radial + gauss(rng) * n);
-    s.normals.push_back(n.normalized());
-  }
-  return s;
-}
+using Samples = qs::test::SurfaceSamples;
+using qs::test::axialSurface;
 
 double angleBetweenAxes(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized()))));
