@@ -3,7 +3,6 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -94,13 +93,12 @@ double QuadricAssociator::correlatedNoiseFactor(const QuadricMeasurement& measur
   const QuadricClass c = measurement.quadric_camera.quadricClass();
   if (f == 0.0 || n < 2.0 || c == QuadricClass::kGeneral || c == QuadricClass::kPlane)
     return 1.0;
-  Eigen::Vector3d sides = (measurement.extent_max - measurement.extent_min).cwiseAbs();
+  const Eigen::Vector3d sides = (measurement.extent_max - measurement.extent_min).cwiseAbs();
   if (!sides.allFinite() || sides.maxCoeff() <= 0.0)
-    return 1.0;
-  std::sort(sides.data(), sides.data() + 3, std::greater<double>());
-  // The support's area: its box's two largest sides (the surface's extent, not its thickness).
-  const double cell = params_.noise_correlation_angle * MeasurementModelError::supportDepth(measurement);
-  const double cells = std::clamp(sides[0] * sides[1] / (cell * cell), 1.0, n);
+    return 1.0;  // no extent to count correlation cells on
+  MeasurementModelError::Params cells_of;
+  cells_of.correlation_angle = params_.noise_correlation_angle;
+  const double cells = MeasurementModelError::independentCells(measurement, cells_of);
   return 1.0 + f * (n / cells - 1.0);
 }
 
@@ -137,8 +135,7 @@ double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
   const double st = params_.pose_translation_sigma, sr = params_.pose_rotation_sigma;
   P.diagonal() += (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr).finished();
   const MatrixK6 J_c_P = J_c.lazyProduct(P);
-  MatrixKK S = measurement.covariance * correlatedNoiseFactor(measurement) +
-               floorCovariance(params_, target.quadric_map);
+  MatrixKK S = associationCovariance(measurement) + floorCovariance(params_, target.quadric_map);
   S += J_c_P.lazyProduct(J_c.transpose());
   if (target.covariance.size() != 0) {
     const MatrixKK J_q_C = J_q.lazyProduct(target.covariance);

@@ -121,9 +121,9 @@ class QuadricAssociator {
   double squaredError(const QuadricMeasurement& measurement, const Eigen::Isometry3d& T_map_camera,
                       const Matrix6d& pose_covariance, const AssociationTarget& target) const;
 
-  // The measurement's covariance as the gate uses it (Sigma_z' above; the general class, whose
-  // covariance already holds the segmenter's model error, and measurements without points or
-  // extent keep Sigma_z).
+  // The measurement's covariance as the gate uses it (Sigma_z' above; planes, the general class,
+  // whose covariance already holds the segmenter's model error, and measurements without points
+  // or extent keep Sigma_z).
   Eigen::MatrixXd associationCovariance(const QuadricMeasurement& measurement) const;
   // The factor 1 + f (n / n_c - 1) of Sigma_z' (1 when it does not apply: planes, general
   // quadrics, f = 0).
