@@ -48,6 +48,7 @@ def main():
     parser.add_argument("--header", default="")
     parser.add_argument("--rate", type=float, default=1.0, help="the playback rate")
     parser.add_argument("--min-share", type=float, default=0.95)
+    parser.add_argument("--live-cpu", help="'user system wall' seconds of the live launch")
     parser.add_argument("--out", required=True)
     args = parser.parse_args()
 
@@ -105,6 +106,15 @@ def main():
         lines.append("CPU to keep up: %.0f ms per frame (sum of the offline medians) x %.1f Hz "
                      "= %.2f cores busy (this machine: %d, shared)" % (
                          per_frame_ms, rate_hz, per_frame_ms * rate_hz / 1e3, os.cpu_count()))
+    if args.live_cpu and os.path.exists(args.live_cpu):
+        with open(args.live_cpu) as f:
+            fields = f.read().split()
+        if len(fields) >= 3 and float(fields[2]) > 0:
+            user, system, wall = (float(v) for v in fields[:3])
+            lines.append("live CPU: %.1f s user + %.1f s system over %.1f s wall = %.2f cores on "
+                         "average (every process of the launch: player, manager, helpers; %d "
+                         "cores here, shared)" % (user, system, wall, (user + system) / wall,
+                                                  os.cpu_count()))
     lines.append("")
     lines.append("result: " + ("PASS (every nodelet >= %.0f %% of the bag's frames)" %
                                (100 * args.min_share) if not failures else

@@ -18,6 +18,18 @@ YamlParamReader YamlParamReader::fromFile(const std::string& path) {
   }
 }
 
+YamlParamReader YamlParamReader::withOverrides(const YamlParamReader& overrides) const {
+  const auto isMapping = [](const YAML::Node& node) { return !node || node.IsNull() || node.IsMap(); };
+  if (!isMapping(root_) || !isMapping(overrides.root_))
+    throw std::runtime_error("parameter overrides need two YAML mappings");
+  YAML::Node merged(YAML::NodeType::Map);
+  for (const YAML::Node* source : {&root_, &overrides.root_})
+    if (*source && source->IsMap())
+      for (const auto& entry : *source)
+        merged[entry.first.as<std::string>()] = YAML::Clone(entry.second);
+  return YamlParamReader(merged);
+}
+
 template <typename T>
 bool YamlParamReader::read(const std::string& key, T& value) const {
   if (!root_ || !root_.IsMap())

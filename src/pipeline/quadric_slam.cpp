@@ -28,14 +28,26 @@ void SlamParams::validate() const {
                                 std::to_string(max_support_points));
 }
 
-SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log) {
+std::string profileDirectory(const std::string& config_dir, const std::string& profile) {
+  if (profile.empty() || profile.find('/') != std::string::npos)
+    return profile;
+  return config_dir + "/profiles/" + profile;
+}
+
+SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log,
+                          const std::string& profile_dir) {
+  if (!profile_dir.empty() && !std::filesystem::is_directory(profile_dir))
+    throw std::runtime_error("configuration profile " + profile_dir + " is not a directory");
   SlamParams params;
   ParamLog discarded;
   ParamLog& effective = log ? *log : discarded;
-  auto reader = [&](const std::string& name) {
-    const std::string path = config_dir + "/" + name;
+  auto fileReader = [](const std::string& path) {
     return std::filesystem::exists(path) ? YamlParamReader::fromFile(path)
                                          : YamlParamReader(YAML::Node(YAML::NodeType::Map));
+  };
+  auto reader = [&](const std::string& name) {
+    const YamlParamReader base = fileReader(config_dir + "/" + name);
+    return profile_dir.empty() ? base : base.withOverrides(fileReader(profile_dir + "/" + name));
   };
   readNormalEstimationParams(reader("normal_estimation.yaml"), params.back_projection,
                              params.normals, effective);

@@ -32,7 +32,8 @@
 // (sim/synthetic_frame_source.h), so a sequence of any length runs without a bag; the truth goes to
 // DIR/groundtruth.txt and is used when --gt is not given.
 //
-//   run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR] [--max-frames N]
+//   run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR] [--profile P]
+//           [--max-frames N]
 //           [--intrinsics fx,fy,cx,cy] [--quiet] [--sample-every N] [--no-rgb] [--no-batch]
 //           [--seconds S] [--rate HZ] [--seed N]   (scene INPUT only)
 #include <pcl/io/pcd_io.h>
@@ -70,6 +71,7 @@ namespace {
 struct Options {
   std::string input, out_dir, gt_path;
   std::string config_dir = QUADRIC_SLAM_CONFIG_DIR;
+  std::string profile;  // a configuration profile over config_dir's files (e.g. qvga)
   bool odometry_only = false;
   bool quiet = false;
   bool rgb = true;    // read RGB when the input has it (it colours the reconstruction only)
@@ -93,12 +95,15 @@ int usage(const std::string& problem) {
   std::cerr
       << "run_bag: " << problem << "\n"
       << "usage: run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR]\n"
-      << "               [--max-frames N] [--intrinsics fx,fy,cx,cy] [--quiet]\n"
+      << "               [--profile NAME|DIR] [--max-frames N] [--intrinsics fx,fy,cx,cy] [--quiet]\n"
       << "               [--sample-every N] [--no-rgb] [--no-batch] [--seconds S] [--rate HZ]\n"
       << "               [--seed N] [--sequential]\n"
       << "  INPUT: a TUM rosbag (.bag), a TUM folder (rgb.txt, depth.txt, depth/), or a scene\n"
       << "         file (config/scenes/*.yaml) rendered frame by frame: --seconds (default 60),\n"
       << "         --rate (default: the scene's), --seed (default 1) apply to it\n"
+      << "  --profile: keys that replace --config's, from DIR/{normal_estimation,segmentation,\n"
+      << "             odometry,mapping}.yaml; NAME = CONFIG/profiles/NAME (qvga: 320x240\n"
+      << "             processing, for machines that cannot keep up at 640x480)\n"
       << "  --sample-every N: a line of DIR/resources.csv every N frames (default 30)\n"
       << "  --no-rgb: depth only (by default RGB, when the input has it, colours the\n"
       << "            reconstruction; frames without an RGB partner run uncoloured)\n"
@@ -126,6 +131,8 @@ bool parseOptions(int argc, char** argv, Options& o, std::string& problem) {
         o.gt_path = value();
       } else if (arg == "--config") {
         o.config_dir = value();
+      } else if (arg == "--profile") {
+        o.profile = value();
       } else if (arg == "--max-frames") {
         o.max_frames = std::stol(value());
       } else if (arg == "--odometry-only") {
@@ -278,7 +285,8 @@ int main(int argc, char** argv) {
     return usage(problem);
 
   try {
-    qs::SlamParams params = qs::loadSlamParams(o.config_dir);
+    const std::string profile_dir = qs::profileDirectory(o.config_dir, o.profile);
+    qs::SlamParams params = qs::loadSlamParams(o.config_dir, nullptr, profile_dir);
     params.mapping_enabled = !o.odometry_only;
     params.batch_refinement = params.batch_refinement && o.batch && !o.odometry_only;
     const bool batch = params.batch_refinement;
@@ -305,6 +313,7 @@ int main(int argc, char** argv) {
                   "merge_ms,keyframe,landmarks,window_keyframes,window_residuals\n";
     if (!o.quiet) {
       std::cerr << "run_bag: " << o.input << ": " << total << " frames, config " << o.config_dir
+                << (profile_dir.empty() ? "" : ", profile " + profile_dir)
                 << (o.odometry_only ? ", odometry only" : "") << "\n";
     }
 

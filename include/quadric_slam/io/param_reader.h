@@ -27,6 +27,9 @@ class YamlParamReader : public ParamReader {
   explicit YamlParamReader(YAML::Node root) : root_(std::move(root)) {}
   // Throws std::runtime_error naming the file when it cannot be read or parsed.
   static YamlParamReader fromFile(const std::string& path);
+  // This mapping with every key of `overrides` (a YAML mapping, e.g. a profile's file) replacing
+  // or adding to its own; throws std::runtime_error when either is not a mapping.
+  YamlParamReader withOverrides(const YamlParamReader& overrides) const;
 
   bool get(const std::string& key, double& value) const override { return read(key, value); }
   bool get(const std::string& key, int& value) const override { return read(key, value); }

@@ -75,7 +75,13 @@ struct SlamParams {
 // the nodelets use (and mapping.yaml's batch_* keys, which only the offline runner uses); absent
 // files keep the defaults of their stage. The effective values go to *log when given. Throws
 // std::runtime_error (unreadable file) or std::invalid_argument (bad value).
-SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log = nullptr);
+// profile_dir (optional, e.g. config/profiles/qvga): files of the same names whose keys replace
+// those of config_dir's files (a profile holds only the keys it changes; absent files change
+// nothing), as the launch files' `profile` argument loads them after config/*.yaml.
+SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log = nullptr,
+                          const std::string& profile_dir = "");
+// The directory of a profile: NAME (no '/') is config_dir/profiles/NAME, anything else a path.
+std::string profileDirectory(const std::string& config_dir, const std::string& profile);
 
 struct SlamFrameResult {
   double stamp = 0.0;
