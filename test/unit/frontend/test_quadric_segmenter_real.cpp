@@ -1,7 +1,7 @@
 // QuadricSegmenter on real Kinect frames:
 // - OSD table-top scenes (../shared/data/mosd_cylinders, learn33..44; research-use, not shipped:
 //   skipped when absent): the table is a plane in every scene, and
-//   at least 80% of the upright cylindrical objects are cylinders whose labels overlap the
+//   at least 90% of the upright cylindrical objects are cylinders whose labels overlap the
 //   object's labelled pixels with IoU >= 0.5.
 // - TUM fr3_long_office_household, depth 1341847980.723020 (test/data): the globe is a sphere,
 //   the desk top and the floor are planes.
@@ -147,7 +147,8 @@ TEST(QuadricSegmenterReal, OsdTablesArePlanesAndUprightCylindersAreCylinders) {
   }
   ASSERT_GT(cylinders, 0);
   std::printf("upright cylinders found: %d of %d\n", found, cylinders);
-  EXPECT_GE(found, 0.8 * cylinders);
+  // The segmentation issue's bar: >= 90% of the upright cylinders (19 of 21 today).
+  EXPECT_GE(found, 0.9 * cylinders);
 }
 
 namespace {
