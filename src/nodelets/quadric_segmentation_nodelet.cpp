@@ -14,6 +14,10 @@
 //             unassigned; only computed while subscribed)
 //             /diagnostics (frames processed and dropped per reason, processing time, output
 //             rate: ros/diagnostics.h)
+// Clouds are segmented by ~workers threads at once (ros/ordered_worker_pool.h): one frame takes
+// longer than a 30 Hz frame period on a small machine, and the nodelet's callbacks run one at a
+// time; observations are still published in the clouds' order. At most ~queue_size clouds wait
+// for a worker; a newer one pushes out the oldest (counted as dropped on /diagnostics).
 // A cloud the segmenter cannot read (see ros/message_validation.h: missing or non-float32 normal
 // fields, not organized, inconsistent sizes) or that makes the core throw gets an error, throttled
 // per reason, and is dropped and counted on /diagnostics.
@@ -26,9 +30,11 @@
 
 #include <chrono>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <pluginlib/class_list_macros.hpp>
 #include <string>
+#include <vector>
 
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/frontend/detection_measurement.h"
@@ -38,6 +44,7 @@
 #include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/drop_reporter.h"
 #include "quadric_slam/ros/frame_ids.h"
+#include "quadric_slam/ros/ordered_worker_pool.h"
 #include "quadric_slam/ros/params.h"
 #include "quadric_slam/ros/points_normals.h"
 
@@ -52,10 +59,16 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
     ParamLog log;
     QuadricSegmenter::Params params;
     int queue_size = 2;
+    int workers = 1;
     try {
       const RosParamReader reader(private_nh);
       readSegmentationParams(reader, params, log);
       readParam(reader, "queue_size", queue_size, log);
+      readParam(reader, "workers", workers, log);
+      if (queue_size < 1)
+        throw std::invalid_argument("queue_size must be >= 1");
+      if (workers < 1 || workers > 8)
+        throw std::invalid_argument("workers must be in [1, 8]");
       readParam(reader, "max_support_points", max_support_points_, log);
       if (max_support_points_ < 0)
         throw std::invalid_argument("max_support_points must be >= 0");
@@ -72,23 +85,39 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
     observations_pub_ = nh.advertise<QuadricObservationArray>("observations", queue_size);
     image_pub_ = private_nh.advertise<sensor_msgs::Image>("segmentation_image", 1);
     cloud_pub_ = private_nh.advertise<sensor_msgs::PointCloud2>("segmented_cloud", 1);
+    clouds_.resize(workers);
+    pool_ = std::make_unique<OrderedWorkerPool>(workers, queue_size);
     cloud_sub_ =
         nh.subscribe("points_normals", queue_size, &QuadricSegmentationNodelet::onCloud, this);
   }
 
-  void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
-    drops_->guard([&] { processCloud(msg); });
+  ~QuadricSegmentationNodelet() override {
+    cloud_sub_.shutdown();
+    pool_.reset();  // running segmentations finish and publish before the members they use go
   }
 
-  void processCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
-    const auto start = std::chrono::steady_clock::now();
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& msg) {
+    drops_->guard([&] {
+      const int pushed_out = pool_->submit([this, msg](int worker) {
+        const auto start = std::chrono::steady_clock::now();
+        // What the worker computed is published (or reported) in the clouds' order.
+        std::function<void()> deliver;
+        drops_->guard([&] { deliver = processCloud(msg, worker, start); });
+        return deliver;
+      });
+      if (pushed_out > 0)
+        diagnostics_->frameDropped("not keeping up: the oldest waiting cloud was dropped");
+    });
+  }
+
+  // Segments msg on worker `worker` (its own cloud storage) and returns what publishes the result.
+  std::function<void()> processCloud(const sensor_msgs::PointCloud2ConstPtr& msg, int worker,
+                                     std::chrono::steady_clock::time_point start) {
     {
-      pcl::PointCloud<pcl::PointNormal>& cloud = cloud_;  // storage kept from frame to frame
+      pcl::PointCloud<pcl::PointNormal>& cloud = clouds_[worker];  // kept from frame to frame
       const std::string problem = pointsNormalsFromMsg(*msg, cloud);
-      if (!problem.empty()) {
-        drops_->drop(problem);
-        return;
-      }
+      if (!problem.empty())
+        return [this, problem] { drops_->drop(problem); };
       const Segmentation segmentation = segmenter_->segment(cloud);
 
       // Every output carries the cloud's header, its frame id without a leading '/'.
@@ -101,19 +130,28 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
       attachSupportPoints(measurements, segmentation, cloud, max_support_points_);
       auto out = boost::make_shared<QuadricObservationArray>(toObservationArrayMsg(measurements));
       out->header = header;
-      observations_pub_.publish(out);
-
-      if (image_pub_.getNumSubscribers() > 0)
-        publishImage(segmentation, header);
-      if (cloud_pub_.getNumSubscribers() > 0)
-        publishCloud(cloud, segmentation, header);
+      const sensor_msgs::ImagePtr image =
+          image_pub_.getNumSubscribers() > 0 ? segmentationImage(segmentation, header) : nullptr;
+      const sensor_msgs::PointCloud2Ptr labelled =
+          cloud_pub_.getNumSubscribers() > 0 ? segmentedCloud(cloud, segmentation, header)
+                                             : nullptr;
+      // The processing time is the worker's, without the wait for the clouds before it.
+      const double processing_ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count();
+      return [this, out, image, labelled, processing_ms] {
+        observations_pub_.publish(out);
+        if (image)
+          image_pub_.publish(image);
+        if (labelled)
+          cloud_pub_.publish(labelled);
+        diagnostics_->frameProcessed(processing_ms);
+      };
     }
-    diagnostics_->frameProcessed(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-            .count());
   }
 
-  void publishImage(const Segmentation& segmentation, const std_msgs::Header& header) {
+  static sensor_msgs::ImagePtr segmentationImage(const Segmentation& segmentation,
+                                                 const std_msgs::Header& header) {
     const cv::Mat rgb = colouriseLabels(segmentation.labels);
     auto image = boost::make_shared<sensor_msgs::Image>();
     image->header = header;
@@ -124,11 +162,12 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
     image->data.resize(static_cast<std::size_t>(image->step) * rgb.rows);
     for (int r = 0; r < rgb.rows; ++r)
       std::memcpy(&image->data[static_cast<std::size_t>(r) * image->step], rgb.ptr(r), image->step);
-    image_pub_.publish(image);
+    return image;
   }
 
-  void publishCloud(const pcl::PointCloud<pcl::PointNormal>& cloud,
-                    const Segmentation& segmentation, const std_msgs::Header& header) {
+  static sensor_msgs::PointCloud2Ptr segmentedCloud(const pcl::PointCloud<pcl::PointNormal>& cloud,
+                                                    const Segmentation& segmentation,
+                                                    const std_msgs::Header& header) {
     pcl::PointCloud<pcl::PointXYZL> labelled(cloud.width, cloud.height);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       labelled.points[i].x = cloud.points[i].x;
@@ -141,18 +180,20 @@ class QuadricSegmentationNodelet : public nodelet::Nodelet {
     auto out = boost::make_shared<sensor_msgs::PointCloud2>();
     pcl::toROSMsg(labelled, *out);
     out->header = header;
-    cloud_pub_.publish(out);
+    return out;
   }
 
   std::unique_ptr<QuadricSegmenter> segmenter_;
   int max_support_points_ = 1000;
   std::unique_ptr<NodeletDiagnostics> diagnostics_;
   std::unique_ptr<DropReporter> drops_;
-  ros::Subscriber cloud_sub_;
-  // The incoming cloud as PCL points: kept, so that a frame of the same size allocates and
-  // zero-fills nothing (15 MB at 640 x 480); callbacks of one nodelet never run concurrently.
-  pcl::PointCloud<pcl::PointNormal> cloud_;
   ros::Publisher observations_pub_, image_pub_, cloud_pub_;
+  // The incoming cloud as PCL points, one per worker: kept, so that a frame of the same size
+  // allocates and zero-fills nothing (15 MB at 640 x 480).
+  std::vector<pcl::PointCloud<pcl::PointNormal>> clouds_;
+  // Declared after everything its jobs use, so it is destroyed (its jobs finished) first.
+  std::unique_ptr<OrderedWorkerPool> pool_;
+  ros::Subscriber cloud_sub_;
 };
 
 }  // namespace quadric_slam
