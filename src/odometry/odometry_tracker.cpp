@@ -30,10 +30,10 @@ void OdometryTracker::Params::validate() const {
     fail("guess_skip_inlier_fraction", "(0, 1]", guess_skip_inlier_fraction);
   if (!(increment_covariance_scale > 0 && increment_covariance_scale <= 1e6))
     fail("increment_covariance_scale", "(0, 1e6]", increment_covariance_scale);
-  if (!(increment_translation_sigma_floor >= 0 && std::isfinite(increment_translation_sigma_floor)))
-    fail("increment_translation_sigma_floor", "[0, inf) m", increment_translation_sigma_floor);
-  if (!(increment_rotation_sigma_floor >= 0 && std::isfinite(increment_rotation_sigma_floor)))
-    fail("increment_rotation_sigma_floor", "[0, inf) rad", increment_rotation_sigma_floor);
+  if (!(increment_translation_fraction >= 0 && std::isfinite(increment_translation_fraction)))
+    fail("increment_translation_fraction", "[0, inf)", increment_translation_fraction);
+  if (!(increment_rotation_per_metre >= 0 && std::isfinite(increment_rotation_per_metre)))
+    fail("increment_rotation_per_metre", "[0, inf) rad/m", increment_rotation_per_metre);
   guess.validate();
 }
 
@@ -70,13 +70,8 @@ OdometryTracker::Matrix6 OdometryTracker::keyframeRelativeCovariance(
   // ICP: T_keyframe_current = exp(xi^) T_hat, xi in the keyframe frame. As a right perturbation,
   // exp(xi^) T_hat = T_hat exp((Ad(T_hat^-1) xi)^), so the body covariance is Ad C Ad^T.
   const Matrix6 ad = adjointSE3(icp.T_reference_current.inverse());
-  Matrix6 body = params_.increment_covariance_scale * (ad * icp.covariance * ad.transpose());
-  body = 0.5 * (body + body.transpose());
-  // The floors: a variance added along each axis (so a degenerate direction stays large).
-  const double ft = params_.increment_translation_sigma_floor;
-  const double fr = params_.increment_rotation_sigma_floor;
-  body.diagonal() += (Vector6d() << ft * ft, ft * ft, ft * ft, fr * fr, fr * fr, fr * fr).finished();
-  return body;
+  const Matrix6 body = ad * icp.covariance * ad.transpose();
+  return 0.5 * (body + body.transpose());
 }
 
 OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_keyframe) const {
@@ -237,8 +232,16 @@ OdometryTracker::Result OdometryTracker::track(
     const Matrix6 current_relative = keyframeRelativeCovariance(icp);
     const Matrix6 ad_back = adjointSE3(increment.inverse());
     increment_covariance =
-        ad_back * keyframe_relative_covariance_ * ad_back.transpose() + current_relative;
+        params_.increment_covariance_scale *
+        (ad_back * keyframe_relative_covariance_ * ad_back.transpose() + current_relative);
     increment_covariance = 0.5 * (increment_covariance + increment_covariance.transpose());
+    // The calibration's error that grows with the step (a variance on each axis, so a degenerate
+    // direction stays large).
+    const double step = increment.translation().norm();
+    const double st = params_.increment_translation_fraction * step;
+    const double sr = params_.increment_rotation_per_metre * step;
+    increment_covariance.diagonal() +=
+        (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr).finished();
     keyframe_relative_covariance_ = current_relative;
     // Only a step constrained in all six directions and accepted by the data sets the velocity;
     // along a degenerate direction the motion is the prior's, which must not feed itself.

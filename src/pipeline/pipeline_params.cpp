@@ -59,9 +59,8 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "guess_max_translation_from_prior", guess.max_translation_from_prior, log);
   readParam(reader, "guess_min_supporting_surfaces", guess.min_supporting_surfaces, log);
   readParam(reader, "increment_covariance_scale", params.increment_covariance_scale, log);
-  readParam(reader, "increment_translation_sigma_floor", params.increment_translation_sigma_floor,
-            log);
-  readParam(reader, "increment_rotation_sigma_floor", params.increment_rotation_sigma_floor, log);
+  readParam(reader, "increment_translation_fraction", params.increment_translation_fraction, log);
+  readParam(reader, "increment_rotation_per_metre", params.increment_rotation_per_metre, log);
   params.validate();
 }
 

@@ -57,16 +57,17 @@ class OdometryTracker {
     // constrained and the alignment accepted); after a degenerate or lost step the prior is the
     // last pose.
     bool zero_motion_start = true;
-    // The increment covariance (Result::increment_covariance) is ICP's sigma^2 H^-1 times this
-    // factor: H^-1 counts every depth pixel as an independent measurement, but real depth noise is
-    // correlated over neighbouring pixels and the point-to-plane model is not exact, so the raw
-    // figure is over-confident (see config/odometry.yaml for the calibration). (0, 1e6]
-    double increment_covariance_scale = 1.0;
-    // ... and each of its translation and rotation standard deviations is at least this (m, rad;
-    // >= 0, finite): the sensor's and the truth's floor below which a frame-to-frame step cannot
-    // be known, whatever the number of pixels.
-    double increment_translation_sigma_floor = 0.0;
-    double increment_rotation_sigma_floor = 0.0;
+    // The increment covariance (Result::increment_covariance) is ICP's sigma^2 H^-1 part times
+    // increment_covariance_scale, (0, 1e6]: H^-1 counts every depth pixel as an independent
+    // measurement, but real depth noise is correlated over neighbouring pixels and the
+    // point-to-plane model is not exact, so the raw figure is over-confident. To it is added, on
+    // each axis, the variance of an error that grows with the step: increment_translation_fraction
+    // (m per m of step, >= 0) on the translation and increment_rotation_per_metre (rad per m of
+    // step, >= 0) on the rotation (the alignment of a longer step ends further from the truth).
+    // Calibrated on the real kitchen and a generated sequence: config/odometry.yaml.
+    double increment_covariance_scale = 4.0;
+    double increment_translation_fraction = 0.05;
+    double increment_rotation_per_metre = 0.05;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -129,7 +130,7 @@ class OdometryTracker {
   bool startsElsewhere(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) const;
   Result output(TrackingStatus status, bool new_keyframe) const;
   // Covariance of the right perturbation of T_keyframe_current (current body tangent) from ICP's
-  // left-perturbation covariance in the keyframe frame, calibrated (scale and floors).
+  // left-perturbation covariance in the keyframe frame (uncalibrated).
   Matrix6 keyframeRelativeCovariance(const PointToPlaneIcp::Result& icp) const;
 
   Params params_;

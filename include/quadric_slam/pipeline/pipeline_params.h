@@ -27,8 +27,8 @@ void readNormalEstimationParams(const ParamReader& reader, BackProjectionParams&
 // min_correspondences, min_eigenvalue_ratio, degenerate_variance, max_translation_from_guess,
 // max_rotation_from_guess, keyframe_translation, keyframe_rotation, keyframe_min_overlap,
 // constant_velocity, lost_frames_before_new_keyframe, the motion guess (guess_*) and the
-// increment covariance's calibration (increment_covariance_scale,
-// increment_translation_sigma_floor, increment_rotation_sigma_floor).
+// increment covariance's calibration (increment_covariance_scale, increment_translation_fraction,
+// increment_rotation_per_metre).
 void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& params, ParamLog& log);
 
 // config/mapping.yaml: the mapper (candidates, association gate, sliding window, keyframes,

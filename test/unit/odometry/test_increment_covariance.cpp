@@ -20,10 +20,15 @@ constexpr double kFrameTime = 1.0 / 30.0;
 constexpr double kDepthNoise = 0.0015;  // m: the synthetic sensor's Gaussian depth noise
 
 // 320 x 240 clouds as in the tracker's other tests; no motion guess (no observations are given).
+// ICP's covariance as it is (no calibration): the synthetic depth noise is independent per pixel,
+// which is what sigma^2 H^-1 assumes.
 OdometryTracker::Params params() {
   OdometryTracker::Params p;
   p.icp.finest_stride = 2;
   p.icp.reference_stride = 1;
+  p.increment_covariance_scale = 1.0;
+  p.increment_translation_fraction = 0.0;
+  p.increment_rotation_per_metre = 0.0;
   return p;
 }
 
@@ -96,15 +101,16 @@ TEST(IncrementCovariance, MatchesMonteCarloOfTwoFramesOnOneKeyframe) {
 }
 
 // The increment right after a keyframe is one alignment: ICP's covariance moved to the body tangent
-// (Ad(T^-1) C Ad(T^-1)^T), times increment_covariance_scale, plus the floors; the next increment
-// adds the previous frame's term.
-TEST(IncrementCovariance, ComposesIcpCovarianceWithScaleAndFloors) {
+// (Ad(T^-1) C Ad(T^-1)^T) times increment_covariance_scale, plus the step's variances
+// (increment_translation_fraction and increment_rotation_per_metre times the step's length); the
+// next increment adds the previous frame's term.
+TEST(IncrementCovariance, ComposesIcpCovarianceWithTheCalibration) {
   const synthetic::Scene scene = synthetic::roomScene();
   const CameraIntrinsics k = synthetic::vgaIntrinsics();
   OdometryTracker::Params p = params();
   p.increment_covariance_scale = 4.0;
-  p.increment_translation_sigma_floor = 0.001;
-  p.increment_rotation_sigma_floor = 0.002;
+  p.increment_translation_fraction = 0.05;
+  p.increment_rotation_per_metre = 0.2;
   OdometryTracker tracker(p);
   tracker.track(*synthetic::renderCloud(scene, view(0), k, 2, kDepthNoise, 1), k, 0.0);
   const OdometryTracker::Result a =
@@ -116,18 +122,21 @@ TEST(IncrementCovariance, ComposesIcpCovarianceWithScaleAndFloors) {
   ASSERT_FALSE(a.new_keyframe);
   const auto relative = [&](const OdometryTracker::Result& r) {
     const Matrix6d ad = adjointSE3(r.icp.T_reference_current.inverse());
-    Matrix6d c = 4.0 * ad * r.icp.covariance * ad.transpose();
-    c.diagonal() += (Vector6d() << 1e-6, 1e-6, 1e-6, 4e-6, 4e-6, 4e-6).finished();
-    return c;
+    return Matrix6d(ad * r.icp.covariance * ad.transpose());
   };
-  const Matrix6d expected_a = relative(a);
+  const auto stepVariances = [](const Eigen::Isometry3d& increment) {
+    const double t = 0.05 * increment.translation().norm();
+    const double r = 0.2 * increment.translation().norm();
+    return Matrix6d((Vector6d() << t * t, t * t, t * t, r * r, r * r, r * r).finished().asDiagonal());
+  };
+  const Matrix6d expected_a = 4.0 * relative(a) + stepVariances(a.increment);
   EXPECT_TRUE(a.increment_covariance.isApprox(expected_a, 1e-9));
   const Matrix6d ad_back = adjointSE3(b.increment.inverse());
-  const Matrix6d expected_b = ad_back * relative(a) * ad_back.transpose() + relative(b);
+  const Matrix6d expected_b =
+      4.0 * (ad_back * relative(a) * ad_back.transpose() + relative(b)) + stepVariances(b.increment);
   EXPECT_TRUE(b.increment_covariance.isApprox(expected_b, 1e-9));
-  // The floors dominate what ICP knows of this well-constrained view: about their size.
-  EXPECT_GT(std::sqrt(a.increment_covariance(0, 0)), 0.001);
-  EXPECT_LT(std::sqrt(a.increment_covariance(0, 0)), 0.002);
+  // The step of about 6 mm: its 5% (0.3 mm) is of the size of ICP's own sigma, so both count.
+  EXPECT_GT(std::sqrt(a.increment_covariance(0, 0)), 0.05 * a.increment.translation().norm());
 }
 
 // No previous frame and a lost frame: the motion is unknown (degenerate_variance everywhere, the
@@ -200,16 +209,17 @@ TEST(IncrementCovariance, CalibrationKeysAreValidated) {
           "increment_covariance_scale");
   rejects([](OdometryTracker::Params& p) { p.increment_covariance_scale = 2e6; },
           "increment_covariance_scale");
-  rejects([](OdometryTracker::Params& p) { p.increment_translation_sigma_floor = -1e-3; },
-          "increment_translation_sigma_floor");
+  rejects([](OdometryTracker::Params& p) { p.increment_translation_fraction = -1e-3; },
+          "increment_translation_fraction");
   rejects(
       [](OdometryTracker::Params& p) {
-        p.increment_rotation_sigma_floor = std::numeric_limits<double>::infinity();
+        p.increment_rotation_per_metre = std::numeric_limits<double>::infinity();
       },
-      "increment_rotation_sigma_floor");
+      "increment_rotation_per_metre");
   OdometryTracker::Params fine;
   fine.increment_covariance_scale = 1e6;
-  fine.increment_translation_sigma_floor = 0;
+  fine.increment_translation_fraction = 0;
+  fine.increment_rotation_per_metre = 0;
   EXPECT_NO_THROW(fine.validate());
 }
 
