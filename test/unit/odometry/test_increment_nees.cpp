@@ -2,8 +2,8 @@
 // Mahalanobis distance of each frame-to-frame step's error against the truth under the reported
 // increment covariance) of the steps reported ok: with a right covariance it is chi-square with 6
 // degrees of freedom, median 5.35. ICP's raw sigma^2 H^-1 is far too confident on real depth
-// (correlated noise, model error); config/odometry.yaml's increment_covariance_scale and floors were
-// chosen from these runs (with QS_TRACKING_CSV_DIR set they write the per-frame values).
+// (correlated noise, model error); config/odometry.yaml's increment_covariance_scale and floors
+// were chosen from these runs (with QS_TRACKING_CSV_DIR set they write the per-frame values).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -50,8 +50,8 @@ test::TrackingRun runKitchen(int every, int max_frames) {
 }
 
 // The band [2.5, 12] around the chi-square median 5.35: a covariance off by a factor of about two
-// either way leaves it. (Raw sigma^2 H^-1, increment_covariance_scale 1 and no floors, gives medians
-// in the hundreds on the kitchen.)
+// either way leaves it. (Raw sigma^2 H^-1, increment_covariance_scale 1 and no floors, gives
+// medians in the hundreds on the kitchen.)
 constexpr double kMinMedianNees = 2.5;
 constexpr double kMaxMedianNees = 12.0;
 

@@ -5,6 +5,7 @@
 // odometry_* model is used instead. The key is read from mapping.yaml.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -22,8 +23,9 @@ namespace {
 
 const std::string kConfigDir = std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config";
 
-struct Run {
-  std::vector<qs::Matrix6d> recorded;  // the recorded keyframes' odometry covariances (from the 2nd)
+struct PipelineRun {
+  std::vector<qs::Matrix6d>
+      recorded;  // the recorded keyframes' odometry covariances (from the 2nd)
   std::vector<qs::Matrix6d> composed;  // the tracker's increments composed between them
   int lost = 0;
 };
@@ -31,7 +33,7 @@ struct Run {
 // A rendered desk sequence at 10 Hz whose depth is blanked for frames [20, 23) (lost frames, the
 // tracker's pose kept) through the pipeline with the batch recorder on (it keeps every keyframe's
 // odometry factor).
-Run run(bool use_increment_covariance) {
+PipelineRun runPipeline(bool use_increment_covariance) {
   qs::SlamParams params = qs::loadSlamParams(kConfigDir);
   params.batch_refinement = true;
   params.odometry_increment_covariance = use_increment_covariance;
@@ -43,7 +45,7 @@ Run run(bool use_increment_covariance) {
   source_params.rgb = false;
   qs::SyntheticFrameSource source(qs::readSceneYaml(kConfigDir + "/scenes/desk.yaml"),
                                   source_params);
-  Run out;
+  PipelineRun out;
   qs::Matrix6d composed = qs::Matrix6d::Zero();
   bool after_keyframe = false;
   qs::RgbdFrame frame;
@@ -76,7 +78,7 @@ bool sameCovariance(const qs::Matrix6d& a, const qs::Matrix6d& b) {
 }  // namespace
 
 TEST(QuadricSlamIncrementCovariance, OdometryFactorsCarryTheTrackersComposedIncrements) {
-  const Run on = run(true);
+  const PipelineRun on = runPipeline(true);
   ASSERT_GT(on.lost, 0) << "the blanked frames no longer lose tracking: the test proves less";
   ASSERT_GE(on.recorded.size(), 3u);
   ASSERT_EQ(on.recorded.size(), on.composed.size());
@@ -94,7 +96,7 @@ TEST(QuadricSlamIncrementCovariance, OdometryFactorsCarryTheTrackersComposedIncr
   }
   EXPECT_LE(relocalised, 1);
 
-  const Run off = run(false);
+  const PipelineRun off = runPipeline(false);
   ASSERT_GE(off.recorded.size(), 3u);
   int same = 0;
   for (size_t i = 0; i < std::min(off.recorded.size(), off.composed.size()); ++i)
