@@ -3,7 +3,10 @@
 //
 // Subscribes  observations (quadric_slam/QuadricObservationArray, camera optical frame; from
 //             quadric_slam/QuadricSegmentation) and odom (nav_msgs/Odometry, pose of the camera in
-//             ~odom_frame; from quadric_slam/Odometry), paired by exact stamp (message_filters).
+//             ~odom_frame; from quadric_slam/Odometry; its twist covariance times dt^2 is the
+//             covariance of the step from the previous odom message, which the mapper's odometry
+//             factors carry with ~odometry_increment_covariance), paired by exact stamp
+//             (message_filters).
 //             The observations are taken to be in odom's child frame (the tracked camera); a
 //             frame id that differs gets a throttled warning (normal_estimation's ~output_frame
 //             names the clouds' frame, odometry's ~camera_frame the tracked one: set them equal).
@@ -55,6 +58,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include <Eigen/Cholesky>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -72,6 +76,7 @@
 #include "quadric_slam/eval/recent_durations.h"
 #include "quadric_slam/eval/resource_usage.h"
 #include "quadric_slam/frontend/support_colours.h"
+#include "quadric_slam/geometry/se3.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "quadric_slam/mapping/reconstruction.h"
 #include "quadric_slam/mapping/recovery_relocalisation.h"
@@ -116,6 +121,36 @@ std::string odometryProblem(const nav_msgs::Odometry& odom, const std::string& o
       return "odom pose covariance has a negative variance (entry " + std::to_string(7 * i) + ")";
   }
   return "";
+}
+
+// The odometry nodelet's increment from the previous odom message (dt s before) to this one,
+// carried as a velocity held over dt: the step is (twist.linear dt, exp(twist.angular dt)) and its
+// covariance ([rho; phi] in this frame's body tangent) the twist covariance times dt^2. False when
+// the twist covariance is not estimated (the 1e6 diagonal of the first message after a start or
+// reset), not finite or not positive definite, or dt <= 0.
+bool incrementFromTwist(const nav_msgs::Odometry& odom, double dt, Eigen::Isometry3d* increment,
+                        Matrix6d* covariance) {
+  if (!(dt > 0.0))
+    return false;
+  Matrix6d twist_covariance;
+  bool not_estimated = true;
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c)
+      twist_covariance(r, c) = odom.twist.covariance[6 * r + c];
+    not_estimated = not_estimated && twist_covariance(r, r) >= 1e6;
+  }
+  if (not_estimated || !twist_covariance.allFinite())
+    return false;
+  *covariance = 0.5 * (twist_covariance + twist_covariance.transpose()) * (dt * dt);
+  if (covariance->llt().info() != Eigen::Success)
+    return false;
+  const auto& v = odom.twist.twist.linear;
+  const auto& w = odom.twist.twist.angular;
+  const Eigen::Vector3d rotation = Eigen::Vector3d(w.x, w.y, w.z) * dt;
+  increment->setIdentity();
+  increment->linear() = expSO3(rotation);
+  increment->translation() = Eigen::Vector3d(v.x, v.y, v.z) * dt;
+  return true;
 }
 
 geometry_msgs::Transform toTransformMsg(const Eigen::Isometry3d& T) {
@@ -176,6 +211,7 @@ class MappingNodelet : public nodelet::Nodelet {
           static_cast<std::size_t>(rgb_buffer_size), rgb_max_stamp_difference);
       readMappingParams(reader, mapper_params, reconstruction_params, log);
       readTrackingRecoveryParams(reader, recovery_params, log);
+      readOdometryIncrementParams(reader, use_increment_covariance_, log);
       if (map_frame_.empty() || odom_frame_.empty() || map_frame_ == odom_frame_)
         throw std::invalid_argument("map_frame and odom_frame must be non-empty and differ");
       if (queue_size < 1)
@@ -376,6 +412,7 @@ class MappingNodelet : public nodelet::Nodelet {
       return;
     }
     checkObservationFrame(observations.header.frame_id, odom.child_frame_id);
+    composeIncrement(odom);
     if (isLost(odom)) {
       // The odometry lost track: its pose is the last one before the loss, not this frame's.
       // Nothing of the frame reaches the map; afterwards the mapper localises until the surfaces
@@ -390,8 +427,12 @@ class MappingNodelet : public nodelet::Nodelet {
       mapper_->setLocalizationOnly(localise_only);
     OdometryInput odometry;
     odometry.T_odom_camera = fromPoseMsg(odom.pose.pose);
-    // The odometry's covariance is cumulative since its start: like QuadricSlam, the mapper uses
-    // its own noise model for the increments (config/mapping.yaml odometry_*).
+    // The odometry's pose covariance is cumulative since its start; the increments since the last
+    // frame the mapper took come from the twist covariance (composeIncrement), as QuadricSlam
+    // passes the tracker's (mapping.yaml odometry_increment_covariance; else, and until a frame
+    // was mapped since the odometry started, the mapper's own odometry_* model).
+    if (use_increment_covariance_ && increment_since_mapped_valid_)
+      odometry.increment_covariance = increment_covariance_since_mapped_;
 
     // 3. Observations: those that do not convert are dropped, the rest of the frame is used.
     FrameMeasurements frame;
@@ -436,6 +477,10 @@ class MappingNodelet : public nodelet::Nodelet {
 
     // 5. The mapper.
     const MapperFrameResult result = mapper_->process(frame, odometry);
+    if (result.status == FrameStatus::kOk) {
+      increment_covariance_since_mapped_.setZero();
+      increment_since_mapped_valid_ = true;
+    }
     if (result.status != FrameStatus::kOk) {
       dropFrame("mapper refused the frame: " + result.message);
       return;
@@ -529,7 +574,30 @@ class MappingNodelet : public nodelet::Nodelet {
   }
 
   // Forgets the map (back to the loaded one, if any), the reconstruction and the path.
+  // Composes the odometry's increment into those since the last frame the mapper took (lost and
+  // refused frames in between; right perturbations: Cov_mc = Ad(T_pc^-1) Cov_mp Ad^T + Cov_pc,
+  // as QuadricSlam does offline). A message without an estimated increment (the odometry started
+  // or reset) starts over: until the mapper takes a frame, its own noise model is used.
+  void composeIncrement(const nav_msgs::Odometry& odom) {
+    const double dt = have_odom_stamp_ ? (odom.header.stamp - last_odom_stamp_).toSec() : 0.0;
+    have_odom_stamp_ = true;
+    last_odom_stamp_ = odom.header.stamp;
+    Eigen::Isometry3d increment;
+    Matrix6d covariance;
+    if (!incrementFromTwist(odom, dt, &increment, &covariance)) {
+      increment_covariance_since_mapped_.setZero();
+      increment_since_mapped_valid_ = false;
+      return;
+    }
+    const Matrix6d ad = adjointSE3(increment.inverse());
+    increment_covariance_since_mapped_ =
+        ad * increment_covariance_since_mapped_ * ad.transpose() + covariance;
+  }
+
   void reset() {
+    have_odom_stamp_ = false;
+    increment_covariance_since_mapped_.setZero();
+    increment_since_mapped_valid_ = false;
     mapper_->reset();
     recovery_.reset();
     mapper_->setLocalizationOnly(user_localization_only_);
@@ -879,6 +947,13 @@ class MappingNodelet : public nodelet::Nodelet {
   // State (mutex_): the core objects and what the outputs need.
   std::mutex mutex_;
   std::unique_ptr<QuadricMapper> mapper_;
+  // mapping.yaml odometry_increment_covariance, and the odometry's increments since the last frame
+  // the mapper took (composeIncrement).
+  bool use_increment_covariance_ = true;
+  Matrix6d increment_covariance_since_mapped_ = Matrix6d::Zero();
+  bool increment_since_mapped_valid_ = false;
+  bool have_odom_stamp_ = false;
+  ros::Time last_odom_stamp_;
   std::unique_ptr<QuadricReconstruction> reconstruction_;
   TrackingRecovery recovery_;
   bool user_localization_only_ = false;  // ~localization_only or the last ~load_map request

@@ -11,7 +11,8 @@
 //             offline runner)
 // Publishes   odom (nav_msgs/Odometry: pose of ~camera_frame in ~odom_frame with covariance;
 //             while tracking is lost, the last pose with every pose variance 9999: ros/
-//             odometry_status.h)
+//             odometry_status.h; twist: the step from the previous message over dt, with the
+//             tracker's increment covariance / dt^2, 1e6 on the diagonal for the first message)
 //             tf ~odom_frame -> ~camera_frame (when ~publish_tf)
 //             /diagnostics (frames processed and dropped per reason, processing time, output
 //             rate: ros/diagnostics.h; and "<name> tracking": ok / degenerate / lost with the ICP
@@ -230,9 +231,14 @@ class OdometryNodelet : public nodelet::Nodelet {
     if (result.status == TrackingStatus::kLost)
       markLost(*odom);  // the last pose, flagged (ros/odometry_status.h)
     // Twist: finite difference of the last two poses, in the camera (child) frame. Its
-    // covariance is not estimated: a large diagonal says so.
+    // covariance carries the tracker's increment covariance from the previous message
+    // (OdometryTracker::Result::increment_covariance, [rho; phi] in this frame's body tangent) as
+    // that of a velocity held over dt: Cov(twist) = Cov(increment) / dt^2; the mapping nodelet
+    // multiplies by dt^2 again. Without a previous pose (the first message) it is not estimated:
+    // a large diagonal (1e6) says so.
     const double dt = (stamp - last_pose_stamp_).toSec();
-    if (last_pose_valid_ && dt > 0) {
+    const bool twist_known = last_pose_valid_ && dt > 0;
+    if (twist_known) {
       const Eigen::Isometry3d delta = last_pose_.inverse() * T;
       const Eigen::AngleAxisd aa(delta.linear());
       const Eigen::Vector3d v = delta.translation() / dt, w = aa.axis() * aa.angle() / dt;
@@ -243,8 +249,15 @@ class OdometryNodelet : public nodelet::Nodelet {
       odom->twist.twist.angular.y = w.y();
       odom->twist.twist.angular.z = w.z();
     }
-    for (int i = 0; i < 6; ++i)
-      odom->twist.covariance[7 * i] = 1e6;
+    if (twist_known) {
+      for (int r = 0; r < 6; ++r) {
+        for (int c = 0; c < 6; ++c)
+          odom->twist.covariance[6 * r + c] = result.increment_covariance(r, c) / (dt * dt);
+      }
+    } else {
+      for (int i = 0; i < 6; ++i)
+        odom->twist.covariance[7 * i] = 1e6;
+    }
     last_pose_ = T;
     last_pose_stamp_ = stamp;
     last_pose_valid_ = true;

@@ -28,6 +28,12 @@ void OdometryTracker::Params::validate() const {
     fail("guess_min_rotation", "(0, pi] rad", guess_min_rotation);
   if (!(guess_skip_inlier_fraction > 0 && guess_skip_inlier_fraction <= 1))
     fail("guess_skip_inlier_fraction", "(0, 1]", guess_skip_inlier_fraction);
+  if (!(increment_covariance_scale > 0 && increment_covariance_scale <= 1e6))
+    fail("increment_covariance_scale", "(0, 1e6]", increment_covariance_scale);
+  if (!(increment_translation_fraction >= 0 && std::isfinite(increment_translation_fraction)))
+    fail("increment_translation_fraction", "[0, inf)", increment_translation_fraction);
+  if (!(increment_rotation_per_metre >= 0 && std::isfinite(increment_rotation_per_metre)))
+    fail("increment_rotation_per_metre", "[0, inf) rad/m", increment_rotation_per_metre);
   guess.validate();
 }
 
@@ -39,7 +45,7 @@ void OdometryTracker::reset() {
   icp_.clearReference();
   keyframe_observations_.clear();
   T_odom_keyframe_ = T_odom_camera_ = last_motion_ = Eigen::Isometry3d::Identity();
-  keyframe_covariance_ = covariance_ = Matrix6::Zero();
+  keyframe_covariance_ = covariance_ = keyframe_relative_covariance_ = Matrix6::Zero();
   last_dt_ = last_stamp_ = 0;
   consecutive_lost_ = 0;
 }
@@ -56,6 +62,16 @@ void OdometryTracker::setKeyframe(const Cloud& cloud, const CameraIntrinsics& in
   }
   T_odom_keyframe_ = T_odom_camera_;
   keyframe_covariance_ = covariance_;
+  keyframe_relative_covariance_ = Matrix6::Zero();  // the reported pose is the keyframe's
+}
+
+OdometryTracker::Matrix6 OdometryTracker::keyframeRelativeCovariance(
+    const PointToPlaneIcp::Result& icp) const {
+  // ICP: T_keyframe_current = exp(xi^) T_hat, xi in the keyframe frame. As a right perturbation,
+  // exp(xi^) T_hat = T_hat exp((Ad(T_hat^-1) xi)^), so the body covariance is Ad C Ad^T.
+  const Matrix6 ad = adjointSE3(icp.T_reference_current.inverse());
+  const Matrix6 body = ad * icp.covariance * ad.transpose();
+  return 0.5 * (body + body.transpose());
 }
 
 OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_keyframe) const {
@@ -156,6 +172,8 @@ OdometryTracker::Result OdometryTracker::track(
     consecutive_lost_ = 0;
     Result out = output(TrackingStatus::kOk, true);
     out.icp.status = TrackingStatus::kOk;
+    // No previous frame: the motion into this one is unknown.
+    out.increment_covariance = Matrix6::Identity() * params_.icp.degenerate_variance;
     return out;
   }
 
@@ -174,6 +192,24 @@ OdometryTracker::Result OdometryTracker::track(
 
   const Eigen::Isometry3d previous = T_odom_camera_;
   bool new_keyframe = false;
+  // The increment T_previous_this and its covariance (Result::increment_covariance).
+  //
+  // Every tracked frame c is aligned to the keyframe K, not to the previous frame p: ICP gives
+  // T_Kc = T_hat_Kc exp(e_c) with Cov(e_c) = C_c (body tangent, keyframeRelativeCovariance).
+  // The increment is T_pc = T_Kp^-1 T_Kc, and with T_Kp = T_hat_Kp exp(e_p),
+  //   T_pc = exp(-e_p) T_hat_pc exp(e_c) = T_hat_pc exp(-Ad(T_hat_pc^-1) e_p + e_c),
+  // so, e_p and e_c coming from different current clouds,
+  //   Cov(xi_pc) = Ad(T_hat_cp) C_p Ad(T_hat_cp)^T + C_c,
+  // with C_p = 0 when p is the keyframe (then T_pc is one alignment). Both alignments share the
+  // keyframe's cloud; its noise correlates e_p and e_c positively, which makes the true increment
+  // covariance smaller than this, never larger (the keyframe's error cancels in T_Kp^-1 T_Kc).
+  // Consecutive increments are correlated through e_p too (one is -Ad e_p, the next +e_p): a
+  // consumer that adds them as independent steps over many frames (the mapper between its
+  // keyframes) over-states the uncertainty of the sum, never under-states it. The keyframe itself
+  // is chained: when c becomes the next keyframe, the following increments are relative to it and
+  // C_c is carried by the increment that reached it.
+  Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
+  Matrix6 increment_covariance = Matrix6::Identity() * params_.icp.degenerate_variance;
   if (icp.status == TrackingStatus::kLost) {
     // Keep the last pose (no velocity: the motion is unknown) and grow the uncertainty.
     ++consecutive_lost_;
@@ -190,6 +226,23 @@ OdometryTracker::Result OdometryTracker::track(
     //                                     = exp(a + Ad(T_odom_kf) b) T_odom_cur.
     const Matrix6 ad = adjointSE3(T_odom_keyframe_);
     covariance_ = keyframe_covariance_ + ad * icp.covariance * ad.transpose();
+    // The increment (derivation above); p is the previous reported pose (the last tracked one
+    // after lost frames, which keep it).
+    increment = pose_math::orthonormalized(previous.inverse() * T_odom_camera_);
+    const Matrix6 current_relative = keyframeRelativeCovariance(icp);
+    const Matrix6 ad_back = adjointSE3(increment.inverse());
+    increment_covariance =
+        params_.increment_covariance_scale *
+        (ad_back * keyframe_relative_covariance_ * ad_back.transpose() + current_relative);
+    increment_covariance = 0.5 * (increment_covariance + increment_covariance.transpose());
+    // The calibration's error that grows with the step (a variance on each axis, so a degenerate
+    // direction stays large).
+    const double step = increment.translation().norm();
+    const double st = params_.increment_translation_fraction * step;
+    const double sr = params_.increment_rotation_per_metre * step;
+    increment_covariance.diagonal() +=
+        (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr).finished();
+    keyframe_relative_covariance_ = current_relative;
     // Only a step constrained in all six directions and accepted by the data sets the velocity;
     // along a degenerate direction the motion is the prior's, which must not feed itself.
     last_motion_ = icp.status == TrackingStatus::kOk
@@ -206,6 +259,9 @@ OdometryTracker::Result OdometryTracker::track(
   last_dt_ = dt > 0 ? dt : 0;
   last_stamp_ = stamp;
   Result result = output(icp.status, new_keyframe);
+  // (A lost frame keeps the pose: identity with the unknown motion's degenerate_variance.)
+  result.increment = increment;
+  result.increment_covariance = increment_covariance;
   result.icp = std::move(icp);
   result.guess = std::move(out.guess);
   result.started_from_guess = out.started_from_guess;

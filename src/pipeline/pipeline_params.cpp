@@ -58,6 +58,9 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "guess_max_rotation_from_prior", guess.max_rotation_from_prior, log);
   readParam(reader, "guess_max_translation_from_prior", guess.max_translation_from_prior, log);
   readParam(reader, "guess_min_supporting_surfaces", guess.min_supporting_surfaces, log);
+  readParam(reader, "increment_covariance_scale", params.increment_covariance_scale, log);
+  readParam(reader, "increment_translation_fraction", params.increment_translation_fraction, log);
+  readParam(reader, "increment_rotation_per_metre", params.increment_rotation_per_metre, log);
   params.validate();
 }
 
@@ -145,6 +148,11 @@ void readBatchRefinementParams(const ParamReader& reader, bool& enabled,
   readParam(reader, "batch_max_keyframes", params.max_keyframes, log);
   readParam(reader, "batch_compute_covariance", params.compute_covariance, log);
   params.validate();
+}
+
+void readOdometryIncrementParams(const ParamReader& reader, bool& use_increment_covariance,
+                                 ParamLog& log) {
+  readParam(reader, "odometry_increment_covariance", use_increment_covariance, log);
 }
 
 }  // namespace quadric_slam

@@ -59,6 +59,7 @@ SlamParams loadSlamParams(const std::string& config_dir, ParamLog* log,
   readMappingParams(mapping, params.mapping, params.reconstruction, effective);
   readTrackingRecoveryParams(mapping, params.recovery, effective);
   readBatchRefinementParams(mapping, params.batch_refinement, params.batch, effective);
+  readOdometryIncrementParams(mapping, params.odometry_increment_covariance, effective);
   params.validate();
   return params;
 }
@@ -184,6 +185,7 @@ SlamFrameResult QuadricSlam::backEnd(FrontEndFrame* front) {
   const CameraIntrinsics& k = front->intrinsics;
 
   // The segmentation's surfaces give the odometry a motion guess for large steps.
+  const bool tracker_was_initialized = odometry_.initialized();
   out.odometry = timeStage(timer_, "odometry", &out.odometry_ms, [&] {
     return odometry_.track(cloud_, k, front->stamp,
                            params_.mapping_enabled ? &out.measurements.observations : nullptr);
@@ -191,6 +193,17 @@ SlamFrameResult QuadricSlam::backEnd(FrontEndFrame* front) {
   out.tracking = odometry_.initialized();
   if (!params_.mapping_enabled || !out.tracking)
     return out;
+  // The tracker's increments reach the mapper composed since the last frame it took (lost and
+  // refused frames in between): with T_m_c = T_m_p T_pc and right perturbations,
+  // Cov_mc = Ad(T_pc^-1) Cov_mp Ad(T_pc^-1)^T + Cov_pc (as the mapper composes its own).
+  if (!tracker_was_initialized) {
+    increment_covariance_since_mapped_.setZero();  // a new odom frame: nothing before counts
+    increment_since_mapped_valid_ = false;
+  } else {
+    const Matrix6d ad = adjointSE3(out.odometry.increment.inverse());
+    increment_covariance_since_mapped_ = ad * increment_covariance_since_mapped_ * ad.transpose() +
+                                         out.odometry.increment_covariance;
+  }
 
   if (out.odometry.status == TrackingStatus::kLost) {
     // The pose is the last one before the loss, not this frame's: nothing of it reaches the map.
@@ -210,9 +223,15 @@ SlamFrameResult QuadricSlam::backEnd(FrontEndFrame* front) {
 
   OdometryInput odometry_input;
   odometry_input.T_odom_camera = out.odometry.T_odom_camera;
+  if (params_.odometry_increment_covariance && increment_since_mapped_valid_)
+    odometry_input.increment_covariance = increment_covariance_since_mapped_;
   out.mapping = timeStage(timer_, "mapping", &out.mapping_ms,
                           [&] { return mapper_.process(out.measurements, odometry_input); });
   out.mapped = out.mapping.status == FrameStatus::kOk;
+  if (out.mapped) {
+    increment_covariance_since_mapped_.setZero();
+    increment_since_mapped_valid_ = true;
+  }
   if (params_.batch_refinement && !batch_overflow_) {
     batch_recorder_.record(out.mapping, mapper_);
     // Too large to solve: the recording stops and its memory is freed (refineBatch() says why).

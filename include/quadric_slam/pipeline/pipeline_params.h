@@ -26,7 +26,9 @@ void readNormalEstimationParams(const ParamReader& reader, BackProjectionParams&
 // depth_noise_weighting, huber_delta, convergence_translation, convergence_rotation,
 // min_correspondences, min_eigenvalue_ratio, degenerate_variance, max_translation_from_guess,
 // max_rotation_from_guess, keyframe_translation, keyframe_rotation, keyframe_min_overlap,
-// constant_velocity, lost_frames_before_new_keyframe.
+// constant_velocity, lost_frames_before_new_keyframe, the motion guess (guess_*) and the
+// increment covariance's calibration (increment_covariance_scale, increment_translation_fraction,
+// increment_rotation_per_metre).
 void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& params, ParamLog& log);
 
 // config/mapping.yaml: the mapper (candidates, association gate, sliding window, keyframes,
@@ -49,5 +51,11 @@ void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Par
 // batch_compute_covariance.
 void readBatchRefinementParams(const ParamReader& reader, bool& enabled,
                                BatchRefiner::Params& params, ParamLog& log);
+
+// config/mapping.yaml odometry_increment_covariance: whether the mapper's odometry factors carry
+// the tracker's increment covariance (true) or the mapper's fixed odometry_* model (false). Read
+// by QuadricSlam and the mapping nodelet.
+void readOdometryIncrementParams(const ParamReader& reader, bool& use_increment_covariance,
+                                 ParamLog& log);
 
 }  // namespace quadric_slam

@@ -66,6 +66,11 @@ struct SlamParams {
   // the nodelets never read it: the recording grows with the run) and its solver parameters.
   bool batch_refinement = false;
   BatchRefiner::Params batch;
+  // mapping.yaml odometry_increment_covariance: the mapper's odometry factors carry the tracker's
+  // increment covariance (OdometryTracker::Result::increment_covariance, the increments of frames
+  // the mapper did not take composed into the next one); false: the mapper's fixed odometry_*
+  // noise model.
+  bool odometry_increment_covariance = true;
 
   // Throws std::invalid_argument naming the bad field (of whichever stage) and its range.
   void validate() const;
@@ -174,6 +179,11 @@ class QuadricSlam {
   StageTimer timer_;
   bool has_stamp_ = false;
   double last_stamp_ = 0.0;
+  // The tracker's increments since the last frame the mapper took, composed (right perturbation
+  // in the latest frame's body tangent); valid once the mapper has taken a frame since the
+  // tracker (re)started, before that the mapper's own model is used.
+  Matrix6d increment_covariance_since_mapped_ = Matrix6d::Zero();
+  bool increment_since_mapped_valid_ = false;
   // The mapper's latest map->odom correction (of the latest mapped frame).
   Eigen::Isometry3d T_map_odom_ = Eigen::Isometry3d::Identity();
   pcl::PointCloud<pcl::PointNormal> cloud_;  // the latest frame's

@@ -81,6 +81,12 @@ TEST(PipelineParams, OdometryYamlKeysAreAllRead) {
   EXPECT_DOUBLE_EQ(params.keyframe_translation, file["keyframe_translation"].as<double>());
   EXPECT_EQ(params.quadric_motion_guess, file["quadric_motion_guess"].as<bool>());
   EXPECT_EQ(params.guess.max_direction_features, file["guess_max_direction_features"].as<int>());
+  EXPECT_DOUBLE_EQ(params.increment_covariance_scale,
+                   file["increment_covariance_scale"].as<double>());
+  EXPECT_DOUBLE_EQ(params.increment_translation_fraction,
+                   file["increment_translation_fraction"].as<double>());
+  EXPECT_DOUBLE_EQ(params.increment_rotation_per_metre,
+                   file["increment_rotation_per_metre"].as<double>());
 }
 
 TEST(PipelineParams, MappingYamlKeysAreAllRead) {
@@ -96,6 +102,11 @@ TEST(PipelineParams, MappingYamlKeysAreAllRead) {
   bool batch_refinement = false;
   qs::BatchRefiner::Params batch;
   qs::readBatchRefinementParams(reader, batch_refinement, batch, log);
+  // Whether the odometry factors carry the odometry's increment covariance (QuadricSlam and the
+  // nodelet).
+  bool increment_covariance = !file["odometry_increment_covariance"].as<bool>();
+  qs::readOdometryIncrementParams(reader, increment_covariance, log);
+  EXPECT_EQ(increment_covariance, file["odometry_increment_covariance"].as<bool>());
   // Nodelet-level keys, read beside the tables.
   std::string text;
   bool flag = false;
