@@ -14,10 +14,10 @@ namespace {
 bool isAxial(QuadricClass c) { return c == QuadricClass::kCylinder || c == QuadricClass::kCone; }
 
 // Radius of the observed surface at height z of its own frame: a cylinder's 1/alpha, a cone's
-// z tan(half-angle) = z / alpha on the named nappe (z >= 0).
+// |z| tan(half-angle) = |z| / alpha (either nappe: a symmetry of the quadric may flip the frame).
 double radiusAt(const QuadricModel& axial, double z) {
   const double alpha = axial.scale().x();
-  return axial.quadricClass() == QuadricClass::kCylinder ? 1.0 / alpha : std::max(0.0, z) / alpha;
+  return axial.quadricClass() == QuadricClass::kCylinder ? 1.0 / alpha : std::abs(z) / alpha;
 }
 
 }  // namespace
@@ -34,13 +34,10 @@ double axialSurfaceDistance(const QuadricModel& axial, const Eigen::Vector3d& p)
   if (axial.quadricClass() != QuadricClass::kCone)
     throw std::invalid_argument("axialSurfaceDistance: needs a cylinder or a cone, got " +
                                 toString(axial.quadricClass()));
-  // In the plane through the axis and p, the nappe is the ray at the half-angle beta from +z:
-  // points whose foot on that line lies before the apex are nearest to the apex.
+  // In the plane through the axis and p, the nearer nappe is the ray at the half-angle beta from
+  // +-z towards p (the quadric is the double cone; a symmetry of it may flip the frame's z).
   const double beta = std::atan(1.0 / axial.scale().x());
-  const double along = rho * std::sin(beta) + p.z() * std::cos(beta);
-  if (along < 0.0)
-    return p.norm();
-  return std::abs(rho * std::cos(beta) - p.z() * std::sin(beta));
+  return std::abs(rho * std::cos(beta) - std::abs(p.z()) * std::sin(beta));
 }
 
 double axialBandDistance(const QuadricModel& observed, const ExtentBox& box,

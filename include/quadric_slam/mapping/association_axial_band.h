@@ -20,7 +20,7 @@ namespace quadric_slam {
 bool axialClassPair(const QuadricModel& a, const QuadricModel& b);
 
 // Orthogonal distance (m) of point p (in the quadric's own frame) from a cylinder's or a cone's
-// surface (a cone's named nappe: points behind the apex measure their distance to the apex).
+// surface (the double cone: a symmetry of the quadric may name either nappe in its frame).
 // Throws std::invalid_argument for the other classes.
 double axialSurfaceDistance(const QuadricModel& axial, const Eigen::Vector3d& p_quadric);
 
