@@ -6,7 +6,7 @@
 #include <string>
 
 #include "quadric_slam/geometry/symmetry.h"
-#include "quadric_slam/mapping/association_axial_band.h"
+#include "quadric_slam/mapping/association_cross_class.h"
 #include "quadric_slam/mapping/param_checks.h"
 
 namespace quadric_slam {
@@ -74,8 +74,9 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
     if (to_landmarks[m].outcome == AssociationOutcome::kMatched) {
       landmark_id = target_ids[to_landmarks[m].target_index];
     } else {
-      // 1b. A cylinder on a cone landmark's band, or the reverse: counted there, no factor.
-      landmark_id = otherAxialClassLandmark(
+      // 1b. A surface fitted with another class than its landmark's (a cone's band as a
+      // cylinder, a patch as a sphere ...): counted there, no factor.
+      landmark_id = otherClassLandmark(
           measurements[m].quadric_camera.transformed(T_map_camera),
           ExtentBox{measurements[m].extent_min, measurements[m].extent_max}, T_map_camera);
       update.measurements[m].without_factor = landmark_id != 0;
@@ -167,7 +168,7 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
     if (promotion_ && candidate.last_frame == frame_index &&
         candidate.observations >= params_.min_observations) {
       const int absorbed =
-          otherAxialClassLandmark(candidate.quadric_map, candidate.extent, T_map_camera);
+          otherClassLandmark(candidate.quadric_map, candidate.extent, T_map_camera);
       if (absorbed != 0) {
         // Its observations count on the landmark of the other class, without factors.
         QuadricLandmark& landmark = landmarks_.at(absorbed);
@@ -254,23 +255,23 @@ int LandmarkRegistry::sameSurfaceLandmark(const QuadricCandidate& candidate,
   return best;
 }
 
-int LandmarkRegistry::otherAxialClassLandmark(const QuadricModel& observed,
+int LandmarkRegistry::otherClassLandmark(const QuadricModel& observed,
                                               const ExtentBox& observed_box,
                                               const Eigen::Isometry3d& T_map_camera) const {
   const QuadricAssociator::Params& p = associator_.params();
-  if (p.axial_band_distance <= 0.0)
+  if (p.cross_class_distance <= 0.0)
     return 0;
   int best = 0;
-  double best_distance = p.axial_band_distance;
+  double best_distance = p.cross_class_distance;
   for (const auto& [id, landmark] : landmarks_) {
-    if (!axialClassPair(observed, landmark.quadric_map) ||
+    if (!crossClassPair(observed, landmark.quadric_map) ||
         !associator_.inRange(landmark.quadric_map, landmarkExtent(landmark), T_map_camera))
       continue;
     const ExtentBox moved =
         observed_box.transformed(landmark.quadric_map.pose().inverse() * observed.pose());
     if (p.check_extent && !moved.overlaps(landmarkExtent(landmark), p.extent_margin))
       continue;
-    const double distance = axialBandDistance(observed, observed_box, landmark.quadric_map);
+    const double distance = crossClassDistance(observed, observed_box, landmark.quadric_map);
     if (distance <= best_distance) {
       best = id;
       best_distance = distance;

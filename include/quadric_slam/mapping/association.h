@@ -103,12 +103,12 @@ class QuadricAssociator {
     // compared at all (m, > 0): keeps the per-frame cost to the landmarks around the camera as the
     // map grows. Targets without a known extent are always compared.
     double max_range = 10.0;
-    // A cylinder measurement left unmatched by the landmarks of its class is associated with a
-    // cone landmark (and a cone measurement with a cylinder landmark) whose surface lies within
-    // this RMS distance of the observed band (m, >= 0; 0 turns the test off; mapping/
-    // association_axial_band.h), extents overlapping as above. It is counted on that landmark but
-    // gives no factor (the observation cost compares one class).
-    double axial_band_distance = 0.02;
+    // A measurement left unmatched by the landmarks of its class is counted on a landmark of
+    // another class whose surface lies within this RMS distance of the observed surface over its
+    // box (m, >= 0; 0 turns the test off; pairs in mapping/association_cross_class.h: cylinder <->
+    // cone, sphere -> cylinder, cone, general), extents overlapping as above. It gives no factor
+    // (the observation cost compares one class).
+    double cross_class_distance = 0.02;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;

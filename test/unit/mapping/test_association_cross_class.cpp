@@ -1,4 +1,4 @@
-// Cylinder <-> cone association (mapping/association_axial_band.h): a band of a cone fitted as a
+// Cylinder <-> cone association (mapping/association_cross_class.h): a band of a cone fitted as a
 // cylinder (and a slender cylinder fitted as a cone) is counted on the landmark of the other class
 // without a factor, so one surface stays one landmark whichever class a frame's fit chose; a
 // cylinder on the cone's axis (a lamp post inside its shade) or around it a few cm out stays a
@@ -9,7 +9,7 @@
 #include <random>
 
 #include "quadric_slam/geometry/shapes.h"
-#include "quadric_slam/mapping/association_axial_band.h"
+#include "quadric_slam/mapping/association_cross_class.h"
 #include "quadric_slam/mapping/landmark_registry.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 #include "synthetic_world.h"
@@ -35,7 +35,7 @@ test::TrueLandmark bandAsCylinder(double s0, double s1, double radius_offset = 0
                         0.5 * (s1 - s0));
 }
 
-TEST(AxialBand, SurfaceDistanceOfACone) {
+TEST(CrossClass, SurfaceDistanceOfACone) {
   const QuadricModel cone = quadricFromShape(ConeShape{Eigen::Vector3d::Zero(), kAxis, 0.45});
   // In the cone's own frame the opening is along +z.
   const double r = 0.3 * std::tan(0.45);
@@ -55,42 +55,42 @@ TEST(AxialBand, SurfaceDistanceOfACone) {
 
 // A coaxial cylinder at the band's middle radius departs from the cone by |t| sin(half-angle) at
 // height t from the middle: RMS over a band of height h is h sin(half-angle) / sqrt(12).
-TEST(AxialBand, CylinderOfAConeBandIsWithinItsSlope) {
+TEST(CrossClass, CylinderOfAConeBandIsWithinItsSlope) {
   const QuadricModel cone = shade().quadric_world;
   for (double h : {0.05, 0.1, 0.2}) {
     const test::TrueLandmark band = bandAsCylinder(0.25 - 0.5 * h, 0.25 + 0.5 * h);
     const double expected = h * std::sin(kHalfAngle) / std::sqrt(12.0);
-    EXPECT_NEAR(axialBandDistance(band.quadric_world, band.extent, cone), expected, 0.02 * expected)
+    EXPECT_NEAR(crossClassDistance(band.quadric_world, band.extent, cone), expected, 0.02 * expected)
         << "band height " << h;
     // The same from the other side: the cone band measured against the cylinder.
     const double s0 = 0.25 - 0.5 * h, s1 = 0.25 + 0.5 * h, r1 = s1 * std::tan(kHalfAngle);
     const ExtentBox cone_band{Eigen::Vector3d(-r1, -r1, s0), Eigen::Vector3d(r1, r1, s1)};
     // (Measured radially to the cylinder: 1 / cos(half-angle) times the above.)
-    EXPECT_NEAR(axialBandDistance(cone, cone_band, band.quadric_world),
+    EXPECT_NEAR(crossClassDistance(cone, cone_band, band.quadric_world),
                 expected / std::cos(kHalfAngle), 0.02 * expected);
   }
   // A sleeve 4 cm outside the band: cos(half-angle) 4 cm away.
   const test::TrueLandmark sleeve = bandAsCylinder(0.2, 0.3, 0.04);
-  EXPECT_GT(axialBandDistance(sleeve.quadric_world, sleeve.extent, cone), 0.035);
+  EXPECT_GT(crossClassDistance(sleeve.quadric_world, sleeve.extent, cone), 0.035);
   // Same class or no box: no comparison.
-  EXPECT_TRUE(std::isinf(axialBandDistance(cone, shade().extent, cone)));
-  EXPECT_TRUE(std::isinf(axialBandDistance(sleeve.quadric_world, ExtentBox{}, cone)));
+  EXPECT_TRUE(std::isinf(crossClassDistance(cone, shade().extent, cone)));
+  EXPECT_TRUE(std::isinf(crossClassDistance(sleeve.quadric_world, ExtentBox{}, cone)));
 }
 
-TEST(AxialBand, ParamIsValidated) {
+TEST(CrossClass, ParamIsValidated) {
   QuadricAssociator::Params p;
-  p.axial_band_distance = -0.01;
+  p.cross_class_distance = -0.01;
   try {
     p.validate();
-    ADD_FAILURE() << "a negative axial_band_distance was accepted";
+    ADD_FAILURE() << "a negative cross_class_distance was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("axial_band_distance"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cross_class_distance"), std::string::npos) << e.what();
   }
 }
 
 // A cone landmark, then frames that see the cone and, as a second measurement, a band of it
 // fitted as a cylinder: one landmark (the cone) that counts both, no cylinder candidate.
-TEST(AxialBand, CylinderObservationsOfAConeBandCountOnTheCone) {
+TEST(CrossClass, CylinderObservationsOfAConeBandCountOnTheCone) {
   LandmarkRegistry map;
   std::mt19937 rng(5);
   for (int frame = 1; frame <= 5; ++frame)
@@ -116,7 +116,7 @@ TEST(AxialBand, CylinderObservationsOfAConeBandCountOnTheCone) {
 
 // Both seen from the first frame: the cylinder's candidate reaches five observations in the frame
 // the cone's is promoted, and is absorbed by the new cone landmark instead of becoming a landmark.
-TEST(AxialBand, CylinderCandidateIsAbsorbedAtPromotion) {
+TEST(CrossClass, CylinderCandidateIsAbsorbedAtPromotion) {
   LandmarkRegistry map;
   std::mt19937 rng(6);
   MapUpdate u;
@@ -135,7 +135,7 @@ TEST(AxialBand, CylinderCandidateIsAbsorbedAtPromotion) {
 }
 
 // The reverse: a cylinder landmark and a band of it fitted as a cone of small half-angle.
-TEST(AxialBand, ConeObservationsOfACylinderCountOnTheCylinder) {
+TEST(CrossClass, ConeObservationsOfACylinderCountOnTheCylinder) {
   const Eigen::Vector3d centre(0.2, -0.3, 0.6);
   const test::TrueLandmark bin = test::cylinder(centre, Eigen::Vector3d::UnitZ(), 0.12, 0.2);
   // Half-angle 0.05 rad with radius 0.12 m at the band's middle: apex 2.4 m below it.
@@ -161,7 +161,7 @@ TEST(AxialBand, ConeObservationsOfACylinderCountOnTheCylinder) {
 
 // Must stay two: a thin post on the cone's axis (inside the shade's extent) and a sleeve 4 cm
 // outside the shade are other surfaces and become cylinder landmarks of their own.
-TEST(AxialBand, NearbyCylindersStayLandmarksOfTheirOwn) {
+TEST(CrossClass, NearbyCylindersStayLandmarksOfTheirOwn) {
   const test::TrueLandmark post = test::cylinder(kApex + 0.3 * kAxis, kAxis, 0.015, 0.2);
   const test::TrueLandmark sleeve = bandAsCylinder(0.2, 0.3, 0.04);
   LandmarkRegistry map;
@@ -180,9 +180,76 @@ TEST(AxialBand, NearbyCylindersStayLandmarksOfTheirOwn) {
   EXPECT_EQ(cylinders, 2);
 }
 
+// A point of the shade at depth s below the apex (on the side facing the camera, -x) and the
+// outward unit normal of the cone there.
+void shadePoint(double s, Eigen::Vector3d* point, Eigen::Vector3d* normal) {
+  const Eigen::Vector3d radial = -Eigen::Vector3d::UnitX();
+  *point = kApex + s * kAxis + s * std::tan(kHalfAngle) * radial;
+  *normal = std::cos(kHalfAngle) * radial - std::sin(kHalfAngle) * kAxis;
+}
+
+TEST(CrossClass, SampsonDistanceOfAnEllipsoid) {
+  const QuadricModel ellipsoid(QuadricClass::kGeneral, Eigen::Isometry3d::Identity(),
+                               Eigen::Vector3d(1 / 0.13, 1 / 0.08, 1 / 0.07),
+                               Eigen::Vector4d(1, 1, 1, -1));
+  EXPECT_NEAR(surfaceDistance(ellipsoid, Eigen::Vector3d(0.13, 0, 0)), 0.0, 1e-12);
+  EXPECT_NEAR(surfaceDistance(ellipsoid, Eigen::Vector3d(0, 0, 0.08)), 0.01, 1e-3);
+  EXPECT_NEAR(surfaceDistance(ellipsoid, Eigen::Vector3d(0, 0.07, 0)), 0.01, 1e-3);
+}
+
+// test::measure re-expresses a measurement by a random symmetry, for a sphere any rotation, which
+// turns its box of supporting points into a much larger axis-aligned box; a segmenter reports a
+// sphere in a camera-aligned frame. This keeps measure's noise and puts the frame back.
+QuadricMeasurement cameraAlignedSphere(const test::TrueLandmark& sphere, std::mt19937& rng) {
+  QuadricMeasurement m = test::measure(sphere, kCamera, rng);
+  Eigen::Isometry3d T_camera_sphere = Eigen::Isometry3d::Identity();
+  T_camera_sphere.translation() = m.quadric_camera.pose().translation();
+  m.quadric_camera = QuadricModel(QuadricClass::kSphere, T_camera_sphere, m.quadric_camera.scale(),
+                                  m.quadric_camera.signature());
+  const ExtentBox box = sphere.extent.transformed(T_camera_sphere.inverse() * kCamera.inverse() *
+                                                  sphere.quadric_world.pose());
+  m.extent_min = box.min;
+  m.extent_max = box.max;
+  m.covariance = test::measurementCovariance(m.quadric_camera);
+  return m;
+}
+
+// A patch of the shade fitted as a sphere (tangent to it along the circle through the patch:
+// centre on the axis, radius = the circle's radius / cos(half-angle)) counts on the cone; a ball
+// touching the shade from outside is another surface and becomes a sphere landmark.
+TEST(CrossClass, SpherePatchOfAConeCountsOnTheConeABallBesideItDoesNot) {
+  Eigen::Vector3d p, n;
+  shadePoint(0.25, &p, &n);
+  const double R = 0.25 * std::tan(kHalfAngle) / std::cos(kHalfAngle);
+  test::TrueLandmark patch = test::sphere(p - R * n, R);
+  patch.extent = {(R * n).array() - 0.04, (R * n).array() + 0.04};
+  EXPECT_LT(crossClassDistance(patch.quadric_world, patch.extent, shade().quadric_world), 0.01);
+  const test::TrueLandmark ball = test::sphere(p + 0.06 * n, 0.06);
+  EXPECT_GT(crossClassDistance(ball.quadric_world, ball.extent, shade().quadric_world), 0.03);
+
+  LandmarkRegistry map;
+  std::mt19937 rng(10);
+  for (int frame = 1; frame <= 15; ++frame) {
+    std::vector<QuadricMeasurement> seen{test::measure(shade(), kCamera, rng),
+                                         test::measure(ball, kCamera, rng)};
+    if (frame > 5)
+      seen.push_back(cameraAlignedSphere(patch, rng));
+    const MapUpdate u = map.integrate(frame, 0.1 * frame, seen, kCamera, Matrix6d::Zero());
+    if (frame > 5) {
+      EXPECT_EQ(u.measurements[2].fate, MeasurementFate::kLandmark) << "frame " << frame;
+      EXPECT_TRUE(u.measurements[2].without_factor);
+      EXPECT_EQ(map.landmark(u.measurements[2].id).quadric_map.quadricClass(), QuadricClass::kCone);
+    }
+  }
+  ASSERT_EQ(map.landmarks().size(), 2u);  // the cone and the ball
+  for (const auto& [id, landmark] : map.landmarks())
+    EXPECT_EQ(landmark.observations,
+              landmark.quadric_map.quadricClass() == QuadricClass::kCone ? 25 : 15);
+}
+
 // Through the mapper: the absorbed cylinder measurements make no factors (a cylinder measurement of
 // a cone landmark has no observation cost), every frame is processed, the map is the cone alone.
-TEST(AxialBand, MapperKeepsOneConeLandmark) {
+TEST(CrossClass, MapperKeepsOneConeLandmark) {
   QuadricMapper mapper;
   std::mt19937 rng(9);
   for (int frame = 0; frame < 30; ++frame) {
