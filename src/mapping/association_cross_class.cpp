@@ -14,9 +14,14 @@ namespace {
 
 bool isAxial(QuadricClass c) { return c == QuadricClass::kCylinder || c == QuadricClass::kCone; }
 
+// A general quadric of the ellipsoid's signature (the only general surface sampled here).
+bool isEllipsoid(const QuadricModel& q) {
+  return q.quadricClass() == QuadricClass::kGeneral && q.signature() == Eigen::Vector4d(1, 1, 1, -1);
+}
+
 // Points of the observed surface (its own frame) on a grid over the box, kept where they lie inside
 // it (the box says which side of the surface the sensor saw): cylinders and cones 8 heights x 72
-// angles, spheres 36 polar x 72 azimuth angles.
+// angles, spheres and ellipsoids 36 polar x 72 azimuth angles.
 std::vector<Eigen::Vector3d> surfacePointsInBox(const QuadricModel& observed,
                                                 const ExtentBox& box) {
   std::vector<Eigen::Vector3d> points;
@@ -26,15 +31,16 @@ std::vector<Eigen::Vector3d> surfacePointsInBox(const QuadricModel& observed,
       points.push_back(p);
   };
   const double alpha = observed.scale().x();
-  if (observed.quadricClass() == QuadricClass::kSphere) {
+  if (observed.quadricClass() == QuadricClass::kSphere || isEllipsoid(observed)) {
+    const Eigen::Vector3d semi_axes = observed.scale().cwiseInverse();
     constexpr int kPolar = 36, kAzimuth = 72;
     for (int i = 0; i < kPolar; ++i) {
       const double theta = M_PI * (i + 0.5) / kPolar;
       for (int j = 0; j < kAzimuth; ++j) {
         const double phi = 2.0 * M_PI * j / kAzimuth;
-        keep(Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
-                             std::cos(theta)) /
-             alpha);
+        keep(semi_axes.cwiseProduct(Eigen::Vector3d(std::sin(theta) * std::cos(phi),
+                                                     std::sin(theta) * std::sin(phi),
+                                                     std::cos(theta))));
       }
     }
     return points;
@@ -60,7 +66,12 @@ bool crossClassPair(const QuadricModel& observed, const QuadricModel& target) {
   const QuadricClass o = observed.quadricClass(), t = target.quadricClass();
   if (isAxial(o) && isAxial(t))
     return o != t;
-  return o == QuadricClass::kSphere && (isAxial(t) || t == QuadricClass::kGeneral);
+  if (o == QuadricClass::kSphere)
+    return isAxial(t) || t == QuadricClass::kGeneral;
+  // An ellipsoid against any curved landmark, general ones included: a general fit of part of a
+  // surface is poorly determined (its minimal-space covariance misses the shape's model error),
+  // so two fits of one patch can fail the association gate yet lie on each other.
+  return isEllipsoid(observed) && t != QuadricClass::kPlane;
 }
 
 double axialSurfaceDistance(const QuadricModel& axial, const Eigen::Vector3d& p) {

@@ -7,7 +7,10 @@
 // points (a grid over the box) are moved into the landmark's frame, and their RMS distance to the
 // landmark's surface decides. For a cylinder against a cone this is the cone's local radius and
 // axis tested over the observed band, which a tilted or short cylinder fit of a band still passes.
-// Pairs compared (observed -> landmark): cylinder <-> cone; sphere -> cylinder, cone, general.
+// Pairs compared (observed -> landmark): cylinder <-> cone; sphere -> cylinder, cone, general;
+// ellipsoid (general, signature +++-) -> sphere, cylinder, cone, general (a general fit of part of
+// a surface is poorly determined: two fits of one patch can fail the gate of their parameters yet
+// lie on each other).
 #pragma once
 
 #include <Eigen/Geometry>

@@ -247,6 +247,54 @@ TEST(CrossClass, SpherePatchOfAConeCountsOnTheConeABallBesideItDoesNot) {
               landmark.quadric_map.quadricClass() == QuadricClass::kCone ? 25 : 15);
 }
 
+test::TrueLandmark ellipsoid(const Eigen::Vector3d& centre, const Eigen::Vector3d& semi_axes,
+                             const ExtentBox& box) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = centre;
+  return {QuadricModel(QuadricClass::kGeneral, pose, semi_axes.cwiseInverse(),
+                       Eigen::Vector4d(1, 1, 1, -1)),
+          box};
+}
+
+// A cushion-like ellipsoid seen from above. A general fit of its top that came out larger (radii
+// +25-50 %, centre lower, the top in place) fails the association gate of the parameters but lies
+// on the landmark over the observed top: it counts on it. An ellipsoid 9 cm beside it (25 cm between
+// centres, outside the association gate) does not.
+TEST(CrossClass, BiasedEllipsoidFitOfAPatchCountsOnItsLandmark) {
+  const Eigen::Vector3d c(0.2, 0.6, 0.3);
+  const test::TrueLandmark cushion = ellipsoid(c, Eigen::Vector3d(0.13, 0.08, 0.07),
+                                               {Eigen::Vector3d(-0.13, -0.08, 0.0),
+                                                Eigen::Vector3d(0.13, 0.08, 0.07)});
+  const test::TrueLandmark biased_top =
+      ellipsoid(c - Eigen::Vector3d(0, 0, 0.015), Eigen::Vector3d(0.16, 0.12, 0.085),
+                {Eigen::Vector3d(-0.08, -0.06, 0.06), Eigen::Vector3d(0.08, 0.06, 0.085)});
+  const test::TrueLandmark beside =
+      ellipsoid(c + Eigen::Vector3d(0, 0.25, 0), Eigen::Vector3d(0.13, 0.08, 0.07),
+                {Eigen::Vector3d(-0.13, -0.08, 0.0), Eigen::Vector3d(0.13, 0.08, 0.07)});
+  EXPECT_LT(crossClassDistance(biased_top.quadric_world, biased_top.extent, cushion.quadric_world),
+            0.01);
+  EXPECT_GT(crossClassDistance(beside.quadric_world, beside.extent, cushion.quadric_world), 0.03);
+
+  LandmarkRegistry map;
+  std::mt19937 rng(11);
+  for (int frame = 1; frame <= 15; ++frame) {
+    std::vector<QuadricMeasurement> seen{test::measure(cushion, kCamera, rng)};
+    if (frame > 5) {
+      seen.push_back(test::measure(biased_top, kCamera, rng));
+      seen.push_back(test::measure(beside, kCamera, rng));
+    }
+    const MapUpdate u = map.integrate(frame, 0.1 * frame, seen, kCamera, Matrix6d::Zero());
+    if (frame > 5) {
+      EXPECT_EQ(u.measurements[1].fate, MeasurementFate::kLandmark) << "frame " << frame;
+      EXPECT_TRUE(u.measurements[1].without_factor);
+      EXPECT_NE(u.measurements[1].landmark_association.outcome, AssociationOutcome::kMatched);
+      EXPECT_FALSE(u.measurements[2].without_factor);
+    }
+  }
+  ASSERT_EQ(map.landmarks().size(), 2u);  // the cushion (counting the biased fits) and its neighbour
+  EXPECT_EQ(map.landmarks().begin()->second.observations, 25);
+}
+
 // Through the mapper: the absorbed cylinder measurements make no factors (a cylinder measurement of
 // a cone landmark has no observation cost), every frame is processed, the map is the cone alone.
 TEST(CrossClass, MapperKeepsOneConeLandmark) {
