@@ -34,6 +34,10 @@
 // parallel surfaces of a real kitchen (doors, drawer fronts) share landmarks: 1000 frames, SLAM
 // ATE 2.8 -> 3.8 cm. General quadrics carry their model error in Sigma_z already.
 //
+// Across classes: a measurement no landmark of its class takes may still lie on a landmark of
+// another class (a cone's band fitted as a cylinder): mapping/association_cross_class.h, applied by
+// the registry (cross_class_distance below).
+//
 // Extents: a match must also let the observed box of supporting points (moved into the target's
 // quadric frame through the predicted pose) overlap the target's box, grown by extent_margin: a
 // second table top at the same height is the same infinite plane, but not the same surface.
