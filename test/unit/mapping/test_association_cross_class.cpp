@@ -114,6 +114,21 @@ TEST(CrossClass, CylinderObservationsOfAConeBandCountOnTheCone) {
   EXPECT_EQ(map.landmark(cone_id).observations, 5 + 2 * 20);
 }
 
+// With the test off (cross_class_distance 0) the same frames make a cylinder landmark beside the
+// cone: the case above is decided by the cross-class test, not by the gate.
+TEST(CrossClass, OffMakesTwoLandmarks) {
+  LandmarkRegistry::Params params;
+  params.association.cross_class_distance = 0.0;
+  LandmarkRegistry map(params);
+  std::mt19937 rng(5);
+  for (int frame = 1; frame <= 12; ++frame)
+    map.integrate(
+        frame, 0.1 * frame,
+        {test::measure(shade(), kCamera, rng), test::measure(bandAsCylinder(0.2, 0.3), kCamera, rng)},
+        kCamera, Matrix6d::Zero());
+  EXPECT_EQ(map.landmarks().size(), 2u);
+}
+
 // Both seen from the first frame: the cylinder's candidate reaches five observations in the frame
 // the cone's is promoted, and is absorbed by the new cone landmark instead of becoming a landmark.
 TEST(CrossClass, CylinderCandidateIsAbsorbedAtPromotion) {
