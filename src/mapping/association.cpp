@@ -74,6 +74,7 @@ void QuadricAssociator::Params::validate() const {
                "noise_correlation_angle", "(0, 0.5] rad");
   requireRange(extent_margin >= 0.0, "extent_margin", "[0, inf) m");
   requireRange(max_range > 0.0, "max_range", "(0, inf) m");
+  requireRange(cross_class_distance >= 0.0, "cross_class_distance", "[0, inf) m");
 }
 
 QuadricAssociator::QuadricAssociator(const Params& params) : params_(params) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "quadric_slam/geometry/symmetry.h"
+#include "quadric_slam/mapping/association_cross_class.h"
 #include "quadric_slam/mapping/param_checks.h"
 
 namespace quadric_slam {
@@ -69,12 +70,23 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
   std::vector<int> rest_index;
   for (size_t m = 0; m < measurements.size(); ++m) {
     update.measurements[m].landmark_association = to_landmarks[m];
-    if (to_landmarks[m].outcome != AssociationOutcome::kMatched) {
+    int landmark_id = 0;
+    if (to_landmarks[m].outcome == AssociationOutcome::kMatched) {
+      landmark_id = target_ids[to_landmarks[m].target_index];
+    } else {
+      // 1b. A surface fitted with another class than its landmark's (a cone's band as a
+      // cylinder, a patch as a sphere ...): counted there, no factor.
+      landmark_id = otherClassLandmark(
+          measurements[m].quadric_camera.transformed(T_map_camera),
+          ExtentBox{measurements[m].extent_min, measurements[m].extent_max}, T_map_camera);
+      update.measurements[m].without_factor = landmark_id != 0;
+    }
+    if (landmark_id == 0) {
       rest.push_back(measurements[m]);
       rest_index.push_back(static_cast<int>(m));
       continue;
     }
-    QuadricLandmark& landmark = landmarks_.at(target_ids[to_landmarks[m].target_index]);
+    QuadricLandmark& landmark = landmarks_.at(landmark_id);
     landmark.observations += 1;
     landmark.last_observed = stamp;
     setLandmarkExtent(&landmark, landmarkExtent(landmark).merged(observedExtentIn(
@@ -155,6 +167,27 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
   for (QuadricCandidate& candidate : candidates_) {
     if (promotion_ && candidate.last_frame == frame_index &&
         candidate.observations >= params_.min_observations) {
+      const int absorbed =
+          otherClassLandmark(candidate.quadric_map, candidate.extent, T_map_camera);
+      if (absorbed != 0) {
+        // Its observations count on the landmark of the other class, without factors.
+        QuadricLandmark& landmark = landmarks_.at(absorbed);
+        landmark.observations += candidate.observations;
+        landmark.last_observed = std::max(landmark.last_observed, candidate.last_observed);
+        setLandmarkExtent(
+            &landmark, landmarkExtent(landmark).merged(candidate.extent.transformed(
+                           landmark.quadric_map.pose().inverse() * candidate.quadric_map.pose())));
+        for (MeasurementResult& result : update.measurements) {
+          if ((result.fate == MeasurementFate::kCandidate ||
+               result.fate == MeasurementFate::kNewCandidate) &&
+              result.id == candidate.id) {
+            result.fate = MeasurementFate::kLandmark;
+            result.id = absorbed;
+            result.without_factor = true;
+          }
+        }
+        continue;
+      }
       const int joined = sameSurfaceLandmark(candidate, T_map_camera);
       if (joined != 0) {
         QuadricLandmark& landmark = landmarks_.at(joined);
@@ -217,6 +250,31 @@ int LandmarkRegistry::sameSurfaceLandmark(const QuadricCandidate& candidate,
     if (c.sameSurface() && c.squared_distance < best_d2) {
       best = id;
       best_d2 = c.squared_distance;
+    }
+  }
+  return best;
+}
+
+int LandmarkRegistry::otherClassLandmark(const QuadricModel& observed,
+                                              const ExtentBox& observed_box,
+                                              const Eigen::Isometry3d& T_map_camera) const {
+  const QuadricAssociator::Params& p = associator_.params();
+  if (p.cross_class_distance <= 0.0)
+    return 0;
+  int best = 0;
+  double best_distance = p.cross_class_distance;
+  for (const auto& [id, landmark] : landmarks_) {
+    if (!crossClassPair(observed, landmark.quadric_map) ||
+        !associator_.inRange(landmark.quadric_map, landmarkExtent(landmark), T_map_camera))
+      continue;
+    const ExtentBox moved =
+        observed_box.transformed(landmark.quadric_map.pose().inverse() * observed.pose());
+    if (p.check_extent && !moved.overlaps(landmarkExtent(landmark), p.extent_margin))
+      continue;
+    const double distance = crossClassDistance(observed, observed_box, landmark.quadric_map);
+    if (distance <= best_distance) {
+      best = id;
+      best_distance = distance;
     }
   }
   return best;

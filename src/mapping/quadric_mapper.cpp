@@ -192,6 +192,8 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
     if (r.fate != MeasurementFate::kLandmark && r.fate != MeasurementFate::kPromoted &&
         r.fate != MeasurementFate::kJoined)
       continue;
+    if (r.without_factor)
+      continue;  // a cylinder on a cone landmark (or the reverse): counted, no factor
     kf.observations.push_back({r.id, valid[m]});
     seen.insert(r.id);
     if (!window_.containsLandmark(r.id))

@@ -81,6 +81,7 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
   readParam(reader, "check_extent", association.check_extent, log);
   readParam(reader, "extent_margin", association.extent_margin, log);
   readParam(reader, "association_max_range", association.max_range, log);
+  readParam(reader, "cross_class_distance", association.cross_class_distance, log);
   LandmarkMerger::Params& merging = map.merging;
   readParam(reader, "merge_landmarks", merging.enabled, log);
   readParam(reader, "merge_gate_probability", merging.gate_probability, log);

@@ -34,6 +34,10 @@
 // parallel surfaces of a real kitchen (doors, drawer fronts) share landmarks: 1000 frames, SLAM
 // ATE 2.8 -> 3.8 cm. General quadrics carry their model error in Sigma_z already.
 //
+// Across classes: a measurement no landmark of its class takes may still lie on a landmark of
+// another class (a cone's band fitted as a cylinder): mapping/association_cross_class.h, applied by
+// the registry (cross_class_distance below).
+//
 // Extents: a match must also let the observed box of supporting points (moved into the target's
 // quadric frame through the predicted pose) overlap the target's box, grown by extent_margin: a
 // second table top at the same height is the same infinite plane, but not the same surface.
@@ -103,6 +107,13 @@ class QuadricAssociator {
     // compared at all (m, > 0): keeps the per-frame cost to the landmarks around the camera as the
     // map grows. Targets without a known extent are always compared.
     double max_range = 10.0;
+    // A measurement left unmatched by the landmarks of its class is counted on a landmark of
+    // another class whose surface lies within this RMS distance of the observed surface over its
+    // box (m, >= 0; 0 turns the test off; pairs in mapping/association_cross_class.h: cylinder <->
+    // cone, sphere -> cylinder, cone, general, ellipsoid -> any curved landmark), extents
+    // overlapping as above. It gives no factor (the observation cost compares one class; a general
+    // measurement the gate refused would pull its landmark's poorly determined shape).
+    double cross_class_distance = 0.02;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;

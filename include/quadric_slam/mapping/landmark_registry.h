@@ -6,7 +6,10 @@
 // surface as a landmark (mapping/landmark_merger.h; the candidate's estimate has no marginal, so
 // the merger's missing covariance stands for it): then it joins that landmark instead. A candidate
 // not seen for candidate_timeout_frames frames expires, so spurious one-off detections never reach
-// the map. Landmarks found to be one surface later are merged through absorbLandmark(), which
+// the map. A measurement (or a candidate at promotion) whose surface lies on a landmark of another
+// class (a cone's band fitted as a cylinder, a patch as a sphere: association_cross_class.h) is
+// counted on that landmark without a factor: one surface, one landmark, whichever class a frame's
+// fit chose. Landmarks found to be one surface later are merged through absorbLandmark(), which
 // keeps a record of the merged ids for subscribers (mergedInto()).
 // Landmark estimates are refined elsewhere (mapping/window.h); here they are created and counted.
 // (The map as published is the message quadric_slam/QuadricMap, ros/map_publisher.h.)
@@ -56,6 +59,9 @@ struct MeasurementResult {
   MeasurementFate fate = MeasurementFate::kNewCandidate;
   int id = 0;
   Association landmark_association;  // the association against the landmarks
+  // kLandmark through the cross-class surface test (association_cross_class.h): the measurement
+  // is of another class than landmark `id`, so it counts on it but makes no factor.
+  bool without_factor = false;
 };
 
 struct MapUpdate {
@@ -135,6 +141,11 @@ class LandmarkRegistry {
   // The landmark (in range of the camera) that `candidate` is the same surface as, or 0.
   int sameSurfaceLandmark(const QuadricCandidate& candidate,
                           const Eigen::Isometry3d& T_map_camera) const;
+  // The landmark of another class (association_cross_class.h: in range of the camera, extents
+  // overlapping) whose surface lies nearest to `observed` over the box `observed_box` (in
+  // observed's frame), within association.cross_class_distance; 0 when none.
+  int otherClassLandmark(const QuadricModel& observed, const ExtentBox& observed_box,
+                              const Eigen::Isometry3d& T_map_camera) const;
 
   Params params_;
   QuadricAssociator associator_;
