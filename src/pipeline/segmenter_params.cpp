@@ -163,7 +163,7 @@ QuadricSegmenter::Params loadSegmenterParams(const std::string& yaml_path) {
   for (const auto& entry : root) {
     const std::string key = entry.first.as<std::string>();
     // The nodelet's own keys (max_support_points: also QuadricSlam's), not the segmenter's.
-    if (key == "queue_size" || key == "max_support_points")
+    if (key == "queue_size" || key == "workers" || key == "max_support_points")
       continue;
     const Entry& e = find(key);
     try {
