@@ -161,6 +161,14 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
       }
     }
   };
+  // A candidate's observations and extent counted on the landmark of its surface.
+  const auto countCandidateOn = [](const QuadricCandidate& candidate, QuadricLandmark* landmark) {
+    landmark->observations += candidate.observations;
+    landmark->last_observed = std::max(landmark->last_observed, candidate.last_observed);
+    setLandmarkExtent(landmark,
+                      landmarkExtent(*landmark).merged(candidate.extent.transformed(
+                          landmark->quadric_map.pose().inverse() * candidate.quadric_map.pose())));
+  };
   // 4. Promotion of candidates seen often enough (this frame's only: others were checked before),
   // or joining the landmark of their surface.
   std::vector<QuadricCandidate> kept;
@@ -171,12 +179,7 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
           otherClassLandmark(candidate.quadric_map, candidate.extent, T_map_camera);
       if (absorbed != 0) {
         // Its observations count on the landmark of the other class, without factors.
-        QuadricLandmark& landmark = landmarks_.at(absorbed);
-        landmark.observations += candidate.observations;
-        landmark.last_observed = std::max(landmark.last_observed, candidate.last_observed);
-        setLandmarkExtent(
-            &landmark, landmarkExtent(landmark).merged(candidate.extent.transformed(
-                           landmark.quadric_map.pose().inverse() * candidate.quadric_map.pose())));
+        countCandidateOn(candidate, &landmarks_.at(absorbed));
         for (MeasurementResult& result : update.measurements) {
           if ((result.fate == MeasurementFate::kCandidate ||
                result.fate == MeasurementFate::kNewCandidate) &&
@@ -190,12 +193,7 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
       }
       const int joined = sameSurfaceLandmark(candidate, T_map_camera);
       if (joined != 0) {
-        QuadricLandmark& landmark = landmarks_.at(joined);
-        landmark.observations += candidate.observations;
-        landmark.last_observed = std::max(landmark.last_observed, candidate.last_observed);
-        setLandmarkExtent(
-            &landmark, landmarkExtent(landmark).merged(candidate.extent.transformed(
-                           landmark.quadric_map.pose().inverse() * candidate.quadric_map.pose())));
+        countCandidateOn(candidate, &landmarks_.at(joined));
         relabel(candidate.id, MeasurementFate::kJoined, joined);
         update.joined.push_back({joined, candidate.history});
         continue;

@@ -11,15 +11,13 @@
 #include <vector>
 
 #include "../test_data.h"
-#include "quadric_slam/io/tum_folder_reader.h"
 #include "quadric_slam/sim/scene_yaml.h"
 #include "quadric_slam/sim/synthetic_frame_source.h"
+#include "kitchen_tracking.h"
 #include "tracking_run.h"
 
 namespace quadric_slam {
 namespace {
-
-const std::string kKitchen = "7scenes_redkitchen";
 
 SlamParams shippedParams() {
   return loadSlamParams(std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config");
@@ -36,19 +34,6 @@ double medianOkNees(const test::TrackingRun& run) {
   return nees[nees.size() / 2];
 }
 
-test::TrackingRun runKitchen(int every, int max_frames) {
-  TumFolderReader::Params reader;
-  reader.load_rgb = false;
-  reader.keep_frames_without_rgb = true;
-  reader.intrinsics.fx = 585;
-  reader.intrinsics.fy = 585;
-  reader.intrinsics.cx = 320;
-  reader.intrinsics.cy = 240;
-  TumFolderReader source(test::sharedData(kKitchen).string(), reader);
-  const Trajectory truth = readTumTrajectory(test::sharedData(kKitchen + "/groundtruth.txt"));
-  return test::runTracker(source, truth, shippedParams(), every, max_frames);
-}
-
 // The band [2.5, 12] around the chi-square median 5.35: a covariance off by a factor of about two
 // either way leaves it. (Raw sigma^2 H^-1, increment_covariance_scale 1 and no floors, gives
 // medians in the hundreds on the kitchen.)
@@ -56,8 +41,8 @@ constexpr double kMinMedianNees = 2.5;
 constexpr double kMaxMedianNees = 12.0;
 
 TEST(IncrementNees, RealKitchenFullRate) {
-  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(kKitchen), test::kResearchUseOnly);
-  const test::TrackingRun run = runKitchen(1, 300);
+  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(test::kKitchen), test::kResearchUseOnly);
+  const test::TrackingRun run = test::runKitchen(1, 300, shippedParams());
   test::writeTrackingCsv(run, "increment_kitchen_every1");
   const double median = medianOkNees(run);
   EXPECT_GT(median, kMinMedianNees);
@@ -65,8 +50,8 @@ TEST(IncrementNees, RealKitchenFullRate) {
 }
 
 TEST(IncrementNees, RealKitchenEveryTenthFrame) {
-  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(kKitchen), test::kResearchUseOnly);
-  const test::TrackingRun run = runKitchen(10, 60);
+  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(test::kKitchen), test::kResearchUseOnly);
+  const test::TrackingRun run = test::runKitchen(10, 60, shippedParams());
   test::writeTrackingCsv(run, "increment_kitchen_every10");
   const double median = medianOkNees(run);
   EXPECT_GT(median, kMinMedianNees);

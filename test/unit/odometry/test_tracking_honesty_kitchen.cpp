@@ -7,26 +7,11 @@
 #include <string>
 
 #include "../test_data.h"
-#include "quadric_slam/io/tum_folder_reader.h"
+#include "kitchen_tracking.h"
 #include "tracking_run.h"
 
 namespace quadric_slam {
 namespace {
-
-const std::string kKitchen = "7scenes_redkitchen";
-
-test::TrackingRun runKitchen(int every, int max_frames, const SlamParams& params) {
-  TumFolderReader::Params reader;
-  reader.load_rgb = false;
-  reader.keep_frames_without_rgb = true;
-  reader.intrinsics.fx = 585;
-  reader.intrinsics.fy = 585;
-  reader.intrinsics.cx = 320;
-  reader.intrinsics.cy = 240;
-  TumFolderReader source(test::sharedData(kKitchen).string(), reader);
-  const Trajectory truth = readTumTrajectory(test::sharedData(kKitchen + "/groundtruth.txt"));
-  return test::runTracker(source, truth, params, every, max_frames);
-}
 
 SlamParams shippedParams() {
   return loadSlamParams(std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config");
@@ -43,14 +28,14 @@ void expectHonest(const test::TrackingRun& run, double min_ok_share, const std::
 }
 
 TEST(TrackingHonestyKitchen, EveryTwentiethFrameIsNeverOkOnAWrongStep) {
-  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(kKitchen), test::kResearchUseOnly);
-  const test::TrackingRun run = runKitchen(20, 50, shippedParams());
+  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(test::kKitchen), test::kResearchUseOnly);
+  const test::TrackingRun run = test::runKitchen(20, 50, shippedParams());
   expectHonest(run, 0.8, "kitchen_every20");
 }
 
 TEST(TrackingHonestyKitchen, EveryTenthFrameIsNeverOkOnAWrongStep) {
-  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(kKitchen), test::kResearchUseOnly);
-  const test::TrackingRun run = runKitchen(10, 60, shippedParams());
+  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(test::kKitchen), test::kResearchUseOnly);
+  const test::TrackingRun run = test::runKitchen(10, 60, shippedParams());
   expectHonest(run, 0.9, "kitchen_every10");
 }
 
@@ -59,12 +44,12 @@ TEST(TrackingHonestyKitchen, EveryTenthFrameIsNeverOkOnAWrongStep) {
 // off, at full rate and every 10th and 20th frame; the thresholds in config/odometry.yaml were read
 // off these files. Run with --gtest_also_run_disabled_tests.
 TEST(TrackingHonestyKitchen, DISABLED_RecordCriterionWithoutThresholds) {
-  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(kKitchen), test::kResearchUseOnly);
+  QS_SKIP_WITHOUT_SHARED_DATA(test::sharedData(test::kKitchen), test::kResearchUseOnly);
   SlamParams params = shippedParams();
   params.odometry.icp.min_overlap_inlier_fraction = 0.0;
   params.odometry.icp.max_rms_residual = 1.0;
   for (const int every : {1, 10, 20})
-    test::writeTrackingCsv(runKitchen(every, every == 1 ? 1000 : 1000 / every, params),
+    test::writeTrackingCsv(test::runKitchen(every, every == 1 ? 1000 : 1000 / every, params),
                            "kitchen_criterion_every" + std::to_string(every));
 }
 
