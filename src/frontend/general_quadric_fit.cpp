@@ -2,7 +2,10 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+
+#include "quadric_slam/frontend/shape_refiner.h"
 
 namespace quadric_slam {
 
@@ -69,11 +72,8 @@ GeneralQuadricFit fitGeneralQuadric(const std::vector<Eigen::Vector3d>& all_poin
   GeneralQuadricFit fit;
   if (all_points.size() < 20)
     return fit;
-  std::vector<Eigen::Vector3d> points;
-  const std::size_t n = std::min<std::size_t>(all_points.size(), std::max(20, max_points));
-  const double step = static_cast<double>(all_points.size()) / static_cast<double>(n);
-  for (std::size_t i = 0; i < n; ++i)
-    points.push_back(all_points[static_cast<std::size_t>(i * step)]);
+  const std::vector<Eigen::Vector3d> points = evenSubsample(all_points, std::max(20, max_points));
+  const std::size_t n = points.size();
 
   for (const auto& p : points)
     fit.centre += p;

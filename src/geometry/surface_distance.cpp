@@ -39,8 +39,7 @@ Eigen::Vector3d closestOnCone(const Eigen::Vector3d& p, double theta) {
 
 // eqs. 2 and 4 evaluated at the homogeneous point [p; 1]
 double algebraicDistance(const QuadricModel& q, const Eigen::Vector3d& p) {
-  const Eigen::Vector3d y = q.scale().cwiseProduct(toQuadric(q, p));
-  return y.dot(q.signature().head<3>().cwiseProduct(y)) + q.signature()[3];
+  return algebraicValueAndSlope(q, p).value;
 }
 
 Eigen::Vector3d algebraicGradient(const QuadricModel& q, const Eigen::Vector3d& p) {
@@ -85,6 +84,11 @@ double exactDistance(const QuadricModel& q, const Eigen::Vector3d& p) {
       break;
   }
   throw std::invalid_argument("exactDistance: not available for general quadrics");
+}
+
+double surfaceDistance(const QuadricModel& q, const Eigen::Vector3d& p) {
+  return q.quadricClass() == QuadricClass::kGeneral ? firstOrderDistance(q, p)
+                                                    : exactDistance(q, p);
 }
 
 void SurfaceProjector::Params::validate() const {

@@ -112,6 +112,15 @@ double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
                                        const Eigen::Isometry3d& T_map_camera,
                                        const Matrix6d& pose_covariance,
                                        const AssociationTarget& target) const {
+  return squaredError(measurement, associationCovariance(measurement), T_map_camera,
+                      pose_covariance, target);
+}
+
+double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
+                                       const Eigen::MatrixXd& measurement_covariance,
+                                       const Eigen::Isometry3d& T_map_camera,
+                                       const Matrix6d& pose_covariance,
+                                       const AssociationTarget& target) const {
   const QuadricModel& z = measurement.quadric_camera;
   if (!sameKind(z, target.quadric_map))
     throw std::invalid_argument("QuadricAssociator: measurement and target of different classes");
@@ -136,7 +145,7 @@ double QuadricAssociator::squaredError(const QuadricMeasurement& measurement,
   const double st = params_.pose_translation_sigma, sr = params_.pose_rotation_sigma;
   P.diagonal() += (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr).finished();
   const MatrixK6 J_c_P = J_c.lazyProduct(P);
-  MatrixKK S = associationCovariance(measurement) + floorCovariance(params_, target.quadric_map);
+  MatrixKK S = measurement_covariance + floorCovariance(params_, target.quadric_map);
   S += J_c_P.lazyProduct(J_c.transpose());
   if (target.covariance.size() != 0) {
     const MatrixKK J_q_C = J_q.lazyProduct(target.covariance);
@@ -177,9 +186,15 @@ std::vector<Association> QuadricAssociator::associate(
   // between kOutsideGate and kNoOverlap and the reported best d^2. Same outcomes as testing every
   // pair, at a fraction of the cost.
   std::vector<std::vector<int>> deferred(measurements.size());
+  // Each measurement's gate covariance once, not once per target it is compared with.
+  std::vector<Eigen::MatrixXd> measurement_covariance;
+  measurement_covariance.reserve(measurements.size());
+  for (const QuadricMeasurement& measurement : measurements)
+    measurement_covariance.push_back(associationCovariance(measurement));
   // d^2 of a pair, kept as the measurement's best; the pair's d^2 when inside the gate, else NaN.
   auto evaluate = [&](size_t m, size_t t) {
-    const double d2 = squaredError(measurements[m], T_map_camera, pose_covariance, targets[t]);
+    const double d2 = squaredError(measurements[m], measurement_covariance[m], T_map_camera,
+                                   pose_covariance, targets[t]);
     if (d2 < out[m].squared_error)
       out[m].squared_error = d2;
     if (out[m].outcome == AssociationOutcome::kNoTargetOfClass)

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <vector>
 
 #include "quadric_slam/geometry/quadric_class.h"
+#include "quadric_slam/geometry/surface_distance.h"
 
 namespace quadric_slam {
 
@@ -74,50 +74,17 @@ bool crossClassPair(const QuadricModel& observed, const QuadricModel& target) {
   return isEllipsoid(observed) && t != QuadricClass::kPlane;
 }
 
-double axialSurfaceDistance(const QuadricModel& axial, const Eigen::Vector3d& p) {
-  const double rho = p.head<2>().norm();
-  if (axial.quadricClass() == QuadricClass::kCylinder)
-    return std::abs(rho - 1.0 / axial.scale().x());
-  if (axial.quadricClass() != QuadricClass::kCone)
-    throw std::invalid_argument("axialSurfaceDistance: needs a cylinder or a cone, got " +
-                                toString(axial.quadricClass()));
-  // In the plane through the axis and p, the nearer nappe is the ray at the half-angle beta from
-  // +-z towards p (the quadric is the double cone; a symmetry of it may flip the frame's z).
-  const double beta = std::atan(1.0 / axial.scale().x());
-  return std::abs(rho * std::cos(beta) - std::abs(p.z()) * std::sin(beta));
-}
-
-double surfaceDistance(const QuadricModel& quadric, const Eigen::Vector3d& p) {
-  switch (quadric.quadricClass()) {
-    case QuadricClass::kCylinder:
-    case QuadricClass::kCone:
-      return axialSurfaceDistance(quadric, p);
-    case QuadricClass::kSphere:
-      return std::abs(p.norm() - 1.0 / quadric.scale().x());
-    case QuadricClass::kPlane:
-      return std::abs(p.x());
-    case QuadricClass::kGeneral:
-      break;
-  }
-  // In its own frame the quadric is sum_i sigma_i s_i^2 x_i^2 + sigma_4 = 0 (eq. 5).
-  const Eigen::Vector3d s2 = quadric.scale().cwiseProduct(quadric.scale());
-  const Eigen::Vector4d& sigma = quadric.signature();
-  const Eigen::Vector3d grad = 2.0 * sigma.head<3>().cwiseProduct(s2).cwiseProduct(p);
-  const double value = sigma.head<3>().cwiseProduct(s2).dot(p.cwiseProduct(p)) + sigma[3];
-  const double norm = grad.norm();
-  return norm > 0.0 ? std::abs(value) / norm : std::numeric_limits<double>::infinity();
-}
-
 double crossClassDistance(const QuadricModel& observed, const ExtentBox& box,
                           const QuadricModel& target) {
   const double inf = std::numeric_limits<double>::infinity();
   if (!crossClassPair(observed, target) || !box.known())
     return inf;
-  const Eigen::Isometry3d T_target_observed = target.pose().inverse() * observed.pose();
   double sum = 0.0;
   int n = 0;
   for (const Eigen::Vector3d& p : surfacePointsInBox(observed, box)) {
-    const double d = surfaceDistance(target, T_target_observed * p);
+    // Exact for the four classes (for a cone, the nearer nappe of the double cone: a symmetry of
+    // the quadric may flip the frame's z); first-order (Sampson) for general quadrics.
+    const double d = surfaceDistance(target, observed.pose() * p);
     sum += d * d;
     ++n;
   }

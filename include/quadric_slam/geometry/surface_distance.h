@@ -27,6 +27,9 @@ double firstOrderDistance(const QuadricModel& quadric, const Eigen::Vector3d& p)
 // Exact Euclidean distance for plane, sphere, cylinder and (double) cone; throws
 // std::invalid_argument for kGeneral.
 double exactDistance(const QuadricModel& quadric, const Eigen::Vector3d& p);
+// Distance from the surface for any class: exact for plane, sphere, cylinder and cone, the
+// first-order (Sampson) distance for general quadrics.
+double surfaceDistance(const QuadricModel& quadric, const Eigen::Vector3d& p);
 
 // Projection of a point onto the surface. Exact closest point for plane, sphere, cylinder and
 // cone; for a general quadric, Newton steps along the gradient p <- p - f grad f / |grad f|^2

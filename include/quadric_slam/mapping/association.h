@@ -155,6 +155,11 @@ class QuadricAssociator {
   const Params& params() const { return params_; }
 
  private:
+  // squaredError with the measurement's gate covariance (associationCovariance) given.
+  double squaredError(const QuadricMeasurement& measurement,
+                      const Eigen::MatrixXd& measurement_covariance,
+                      const Eigen::Isometry3d& T_map_camera, const Matrix6d& pose_covariance,
+                      const AssociationTarget& target) const;
   Params params_;
   std::array<double, 5> gates_{};
 };

@@ -24,16 +24,6 @@ namespace quadric_slam {
 // through the surface test (the pairs above).
 bool crossClassPair(const QuadricModel& observed, const QuadricModel& target);
 
-// Orthogonal distance (m) of point p (in the quadric's own frame) from a cylinder's or a cone's
-// surface (the double cone: a symmetry of the quadric may name either nappe in its frame).
-// Throws std::invalid_argument for the other classes.
-double axialSurfaceDistance(const QuadricModel& axial, const Eigen::Vector3d& p_quadric);
-
-// Distance (m) of point p (in the quadric's own frame) from the surface: exact for spheres,
-// cylinders, cones and planes; the first-order (Sampson) distance |p^T Q p| / (2 |grad|) for
-// general quadrics.
-double surfaceDistance(const QuadricModel& quadric, const Eigen::Vector3d& p_quadric);
-
 // RMS distance (m) from the surface of `observed` (in frame M), over its box of supporting points
 // `observed_box` (in the observed quadric's frame), to the surface of `target` (in frame M).
 // Infinity when the pair is not one of the above, or the box is unknown or holds no point of the

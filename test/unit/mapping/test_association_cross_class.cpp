@@ -9,6 +9,7 @@
 #include <random>
 
 #include "quadric_slam/geometry/shapes.h"
+#include "quadric_slam/geometry/surface_distance.h"
 #include "quadric_slam/mapping/association_cross_class.h"
 #include "quadric_slam/mapping/landmark_registry.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
@@ -35,22 +36,25 @@ test::TrueLandmark bandAsCylinder(double s0, double s1, double radius_offset = 0
                         0.5 * (s1 - s0));
 }
 
+// The landmark's surface distance (geometry/surface_distance.h, points in the parent frame) on a
+// cone's double nappe, as the cross-class test uses it.
 TEST(CrossClass, SurfaceDistanceOfACone) {
   const QuadricModel cone = quadricFromShape(ConeShape{Eigen::Vector3d::Zero(), kAxis, 0.45});
-  // In the cone's own frame the opening is along +z.
+  // Points given in the cone's own frame, where the opening is along +z.
+  auto distance = [&](const Eigen::Vector3d& p_cone) {
+    return surfaceDistance(cone, cone.pose() * p_cone);
+  };
   const double r = 0.3 * std::tan(0.45);
-  EXPECT_NEAR(axialSurfaceDistance(cone, Eigen::Vector3d(r, 0, 0.3)), 0.0, 1e-12);
+  EXPECT_NEAR(distance(Eigen::Vector3d(r, 0, 0.3)), 0.0, 1e-12);
   // 1 cm outside radially: cos(half-angle) cm from the nappe.
-  EXPECT_NEAR(axialSurfaceDistance(cone, Eigen::Vector3d(0, r + 0.01, 0.3)), 0.01 * std::cos(0.45),
-              1e-12);
+  EXPECT_NEAR(distance(Eigen::Vector3d(0, r + 0.01, 0.3)), 0.01 * std::cos(0.45), 1e-12);
   // On the axis: sin(half-angle) times the distance to the apex, on either side of it (the quadric
   // is the double cone; a frame flipped by a symmetry names the other nappe).
-  EXPECT_NEAR(axialSurfaceDistance(cone, Eigen::Vector3d(0, 0, -0.2)), 0.2 * std::sin(0.45), 1e-12);
-  EXPECT_NEAR(axialSurfaceDistance(cone, Eigen::Vector3d(-r, 0, -0.3)), 0.0, 1e-12);
+  EXPECT_NEAR(distance(Eigen::Vector3d(0, 0, -0.2)), 0.2 * std::sin(0.45), 1e-12);
+  EXPECT_NEAR(distance(Eigen::Vector3d(-r, 0, -0.3)), 0.0, 1e-12);
   const QuadricModel cylinder = quadricFromShape(CylinderShape{Eigen::Vector3d::Zero(), kAxis, 0.1});
-  EXPECT_NEAR(axialSurfaceDistance(cylinder, Eigen::Vector3d(0.13, 0, 5.0)), 0.03, 1e-12);
-  EXPECT_THROW(axialSurfaceDistance(quadricFromShape(SphereShape{}), Eigen::Vector3d::Zero()),
-               std::invalid_argument);
+  EXPECT_NEAR(surfaceDistance(cylinder, cylinder.pose() * Eigen::Vector3d(0.13, 0, 5.0)), 0.03,
+              1e-12);
 }
 
 // A coaxial cylinder at the band's middle radius departs from the cone by |t| sin(half-angle) at
