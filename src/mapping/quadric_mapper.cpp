@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "quadric_slam/mapping/factors.h"
+#include "quadric_slam/mapping/motion_bound.h"
 #include "quadric_slam/mapping/param_checks.h"
 
 namespace quadric_slam {
@@ -44,6 +45,10 @@ void QuadricMapper::Params::validate() const {
   requireRange(odometry_rotation_sigma >= 0.0, "odometry_rotation_sigma", "[0, inf) rad");
   requireRange(odometry_rotation_fraction >= 0.0, "odometry_rotation_fraction", "[0, inf)");
   requireRange(odometry_rotation_per_metre >= 0.0, "odometry_rotation_per_metre", "[0, inf) rad/m");
+  requireRange(max_camera_speed >= 0.0 && std::isfinite(max_camera_speed), "max_camera_speed",
+               "[0, inf) m/s");
+  requireRange(max_camera_angular_speed >= 0.0 && std::isfinite(max_camera_angular_speed),
+               "max_camera_angular_speed", "[0, inf) rad/s");
   requireRange(odometry_translation_sigma > 0.0 || odometry_translation_fraction > 0.0,
                "odometry_translation_sigma", "(0, inf) m when odometry_translation_fraction is 0");
   requireRange(odometry_rotation_sigma > 0.0 || odometry_rotation_fraction > 0.0 ||
@@ -127,7 +132,12 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
     } catch (const std::invalid_argument& e) {
       return refuse(FrameStatus::kRejectedOdometry, e.what());
     }
-    increment_covariance = odometry.increment_covariance;
+    // Degenerate and lost frames report a variance (1 m^2 and more) no camera motion explains.
+    increment_covariance =
+        has_frame_ ? boundIncrementCovariance(odometry.increment_covariance,
+                                              frame.stamp - last_stamp_, params_.max_camera_speed,
+                                              params_.max_camera_angular_speed)
+                   : Matrix6d(odometry.increment_covariance);
   } else {
     increment_covariance = incrementCovariance(T_previous_this);
   }

@@ -110,6 +110,8 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
   readParam(reader, "odometry_rotation_sigma", mapper.odometry_rotation_sigma, log);
   readParam(reader, "odometry_rotation_fraction", mapper.odometry_rotation_fraction, log);
   readParam(reader, "odometry_rotation_per_metre", mapper.odometry_rotation_per_metre, log);
+  readParam(reader, "max_camera_speed", mapper.max_camera_speed, log);
+  readParam(reader, "max_camera_angular_speed", mapper.max_camera_angular_speed, log);
   readParam(reader, "model_error_sigma", mapper.model_error.sigma, log);
   readParam(reader, "model_error_correlation_angle", mapper.model_error.correlation_angle, log);
   readParam(reader, "reconstruction_voxel_size", reconstruction.voxel_size, log);

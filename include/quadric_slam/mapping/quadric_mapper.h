@@ -105,6 +105,11 @@ class QuadricMapper {
     double odometry_rotation_sigma = 0.002;
     double odometry_rotation_fraction = 0.05;
     double odometry_rotation_per_metre = 0.02;
+    // The camera's speed bound (1-sigma): an increment covariance from the tracker over dt seconds
+    // is clamped to (max_camera_speed dt)^2 in translation and (max_camera_angular_speed dt)^2 in
+    // rotation along any direction (mapping/motion_bound.h). m/s, rad/s; > 0, or 0 for no bound.
+    double max_camera_speed = 1.0;
+    double max_camera_angular_speed = 2.0;
     // The depth camera's systematic error added to every measurement's covariance as it enters
     // the mapper (mapping/measurement_model_error.h), so that the association gate, the window's
     // weights and the merger see what a fragment of a surface really tells.

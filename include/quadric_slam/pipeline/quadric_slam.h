@@ -68,8 +68,8 @@ struct SlamParams {
   BatchRefiner::Params batch;
   // mapping.yaml odometry_increment_covariance: the mapper's odometry factors carry the tracker's
   // increment covariance (OdometryTracker::Result::increment_covariance, the increments of frames
-  // the mapper did not take composed into the next one); false: the mapper's fixed odometry_*
-  // noise model.
+  // the mapper did not take composed into the next one; across a loss of tracking the mapper's
+  // own model); false: the mapper's fixed odometry_* noise model.
   bool odometry_increment_covariance = true;
 
   // Throws std::invalid_argument naming the bad field (of whichever stage) and its range.
