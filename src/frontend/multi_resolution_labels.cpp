@@ -17,6 +17,7 @@ QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) 
   c.min_curved_points = std::max(4, p.min_curved_points / (d * d));
   c.planes.seed_stride = std::max(1, p.planes.seed_stride / d);
   c.planes.cell_size = p.planes.cell_size / d;
+  c.planes.correlated_points = std::max(1.0, p.planes.correlated_points / (d * d));
   c.cgal_stride = std::max(1, (p.cgal_stride + d / 2) / d);
   c.decimation = 1;
   return c;

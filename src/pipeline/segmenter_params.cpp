@@ -60,6 +60,8 @@ const std::vector<Entry>& table() {
            [](Params& p) -> double& { return p.planes.fill_max_normal_angle; }),
       integer("plane_cell_size", [](Params& p) -> int& { return p.planes.cell_size; }),
       real("plane_cell_min_depth", [](Params& p) -> double& { return p.planes.cell_min_depth; }),
+      real("depth_correlated_points",
+           [](Params& p) -> double& { return p.planes.correlated_points; }),
       flag("detect_spheres", [](Params& p) -> bool& { return p.detect_spheres; }),
       flag("detect_cylinders", [](Params& p) -> bool& { return p.detect_cylinders; }),
       flag("detect_cones", [](Params& p) -> bool& { return p.detect_cones; }),
