@@ -23,6 +23,15 @@ QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) 
   return c;
 }
 
+pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNormal>& cloud, int d) {
+  pcl::PointCloud<pcl::PointNormal> grid(cloud.width / d, cloud.height / d);
+  grid.is_dense = false;
+  for (std::uint32_t r = 0; r < grid.height; ++r)
+    for (std::uint32_t c = 0; c < grid.width; ++c)
+      grid(c, r) = cloud(c * d, r * d);
+  return grid;
+}
+
 namespace {
 
 // Distance gate, in RMS of a detection's fit, within which a pixel inside a single surface's
@@ -38,7 +47,7 @@ bool validPoint(const pcl::PointNormal& q, const QuadricSegmenter::Params& p) {
 }  // namespace
 
 Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
-                      const QuadricSegmenter::Params& p) {
+                      const QuadricSegmenter::Params& p, const std::vector<std::uint8_t>* taken) {
   Segmentation result;
   result.timings = coarse.timings;
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
@@ -76,8 +85,9 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
     // Labels pixel (u, v) with the best of the distinct candidate labels, if any fits.
     const auto labelPixel = [&](int u, int v, const std::uint16_t* labels, int distinct,
                                 bool single_surface, std::uint16_t* label_row) {
-      const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
-      if (!validPoint(q, p))
+      const std::size_t index = static_cast<std::size_t>(v) * width + u;
+      const pcl::PointNormal& q = cloud.points[index];
+      if (!validPoint(q, p) || (taken && (*taken)[index]))
         return;
       const Eigen::Vector3d point = pointOf(q);
       int best = 0;

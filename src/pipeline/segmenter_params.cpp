@@ -35,6 +35,7 @@ const std::vector<Entry>& table() {
       real("min_range", [](Params& p) -> double& { return p.min_range; }),
       real("max_range", [](Params& p) -> double& { return p.max_range; }),
       integer("decimation", [](Params& p) -> int& { return p.decimation; }),
+      integer("curved_decimation", [](Params& p) -> int& { return p.curved_decimation; }),
       integer("boundary_rings", [](Params& p) -> int& { return p.boundary_rings; }),
       integer("threads", [](Params& p) -> int& { return p.threads; }),
       real("plane_max_normal_angle",
