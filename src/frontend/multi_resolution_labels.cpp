@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "quadric_slam/frontend/parallel_chunks.h"
@@ -47,7 +48,7 @@ bool validPoint(const pcl::PointNormal& q, const QuadricSegmenter::Params& p) {
 }  // namespace
 
 Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
-                      const QuadricSegmenter::Params& p, const std::vector<std::uint8_t>* taken) {
+                      const QuadricSegmenter::Params& p) {
   Segmentation result;
   result.timings = coarse.timings;
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
@@ -85,9 +86,8 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
     // Labels pixel (u, v) with the best of the distinct candidate labels, if any fits.
     const auto labelPixel = [&](int u, int v, const std::uint16_t* labels, int distinct,
                                 bool single_surface, std::uint16_t* label_row) {
-      const std::size_t index = static_cast<std::size_t>(v) * width + u;
-      const pcl::PointNormal& q = cloud.points[index];
-      if (!validPoint(q, p) || (taken && (*taken)[index]))
+      const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
+      if (!validPoint(q, p))
         return;
       const Eigen::Vector3d point = pointOf(q);
       int best = 0;
@@ -172,7 +172,7 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
   for (int k = 0; k < n; ++k) {
     if (count[k] == 0)
       continue;
-    QuadricDetection detection = coarse.detections[k];
+    QuadricDetection detection = std::move(coarse.detections[k]);
     detection.label = static_cast<std::uint16_t>(result.detections.size() + 1);
     relabel[k + 1] = detection.label;
     // The covariance, sigma^2 (J^T J)^-1, follows the full-resolution support: J^T J grows with
@@ -190,10 +190,13 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
                              box[k].height - box[k].y_offset + 1};
     result.detections.push_back(std::move(detection));
   }
-  for (int v = 0; v < height; ++v) {
-    std::uint16_t* row = result.labels.ptr<std::uint16_t>(v);
-    for (int u = 0; u < width; ++u)
-      row[u] = relabel[row[u]];
+  // The labels change only when a detection was dropped (renumbering is the identity otherwise).
+  if (static_cast<int>(result.detections.size()) < n) {
+    for (int v = 0; v < height; ++v) {
+      std::uint16_t* row = result.labels.ptr<std::uint16_t>(v);
+      for (int u = 0; u < width; ++u)
+        row[u] = relabel[row[u]];
+    }
   }
   return result;
 }

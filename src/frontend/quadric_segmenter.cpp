@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -158,11 +159,14 @@ Segmentation segmentCurvedCoarser(const SegmentationFrame& frame, const QuadricS
   start = std::chrono::steady_clock::now();
   verifyCurvedCandidates(coarse_frame, candidates, coarse_params, refiner,
                          acceptInto(coarse_frame, coarse));
-  // Pixels of frame that are used (planes) or invalid stay out.
-  std::vector<std::uint8_t> taken(frame.used);
-  for (std::size_t i = 0; i < taken.size(); ++i)
-    taken[i] |= !frame.valid[i];
-  Segmentation curved = upsample(frame.cloud, std::move(coarse), c, p, &taken);
+  // The curved segments take only the free points of frame's grid: the others (planes, invalid)
+  // are hidden from the labelling.
+  pcl::PointCloud<pcl::PointNormal> free_points = frame.cloud;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < free_points.size(); ++i)
+    if (frame.used[i] || !frame.valid[i])
+      free_points.points[i].z = nan;
+  Segmentation curved = upsample(free_points, std::move(coarse), c, p);
   timings.verify_ms = msSince(start);
   return curved;
 }

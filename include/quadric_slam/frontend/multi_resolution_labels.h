@@ -22,10 +22,8 @@ pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNorm
 // the label of a neighbouring coarse sample whose surface it fits (distance threshold and normal
 // agreement, as on the coarse grid; no normal needed within 3 x the fit's RMS of a surface that is
 // the only one among the neighbouring samples);
-// support, fit RMS, ROI, extent and covariance follow the full-resolution points. Pixels with
-// taken[i] != 0 (when given: the cloud's size) stay unlabelled (another segmentation owns them).
+// support, fit RMS, ROI, extent and covariance follow the full-resolution points.
 Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
-                      const QuadricSegmenter::Params& p,
-                      const std::vector<std::uint8_t>* taken = nullptr);
+                      const QuadricSegmenter::Params& p);
 
 }  // namespace quadric_slam
