@@ -206,9 +206,9 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
 
   const int c = p.curved_decimation;
   if (c > 1 && width >= 4 * c && height >= 4 * c) {
-    // 2-3. The curved stages on a coarser grid: a curved surface needs fewer samples than a plane
-    // to be found and told from the others (a plane's extent and its fragments' merging need the
-    // finer grid), and their cost grows with the samples.
+    // 2-3. The curved stages on a coarser grid, whose cost grows with the samples; the planes
+    // stay on this one (a plane's extent and the merging of its fragments need it). Their labels
+    // follow the planes' in numbering.
     Segmentation curved = segmentCurvedCoarser(frame, p, refiner, result.timings);
     for (QuadricDetection& detection : curved.detections)
       detection.label = static_cast<std::uint16_t>(detection.label + result.detections.size());
