@@ -1,5 +1,7 @@
 #include "quadric_slam/frontend/curved_model_selection.h"
 
+#include <algorithm>
+
 #include "quadric_slam/frontend/curved_shape_starts.h"
 #include "quadric_slam/frontend/curved_verification.h"
 
@@ -9,19 +11,25 @@ namespace {
 
 // Whether a cone explains n points significantly better than a cylinder (one parameter more): the
 // drop in the residual sum of squares against the cone's residual variance, over the independent
-// points among them (neighbouring depths of the decimated grid are correlated: about one in
-// kCorrelatedGridPoints is independent), above chi^2(1) at 99.9 % (10.83). On a wide patch of a
-// cone a cylinder leaves residuals barely above the far depth noise (RMS ratio 1.1), yet over a
-// thousand points the difference is decisive; the RMS ratio alone (cylinder_rms_ratio) misses it.
-constexpr double kCorrelatedGridPoints = 4.0;
+// points among them (neighbouring depths are correlated: about one in correlatedGridPoints() is
+// independent), above chi^2(1) at 99.9 % (10.83). On a wide patch of a cone a cylinder leaves
+// residuals barely above the far depth noise (RMS ratio 1.1), yet over a thousand points the
+// difference is decisive; the RMS ratio alone (cylinder_rms_ratio) misses it.
 constexpr double kConeChiSquare = 10.83;
 
-bool coneSignificantlyBetter(double cone_rms, double cylinder_rms, std::size_t n) {
+// Correlated points of the grid the shapes are fitted on: a quarter of those the plane statistics
+// count (PlaneRegionGrower::Params::correlated_points), the ratio tuned on the grid decimated by 2
+// (16 there, 4 here), so that the test's power does not change with the grid's decimation.
+double correlatedGridPoints(const QuadricSegmenter::Params& p) {
+  return std::max(1.0, p.planes.correlated_points / 4.0);
+}
+
+bool coneSignificantlyBetter(double cone_rms, double cylinder_rms, std::size_t n,
+                             const QuadricSegmenter::Params& p) {
   if (!(cone_rms > 0) || cylinder_rms <= cone_rms)
     return false;
-  const double independent = static_cast<double>(n) / kCorrelatedGridPoints;
-  return independent * (cylinder_rms * cylinder_rms - cone_rms * cone_rms) /
-             (cone_rms * cone_rms) >
+  const double independent = static_cast<double>(n) / correlatedGridPoints(p);
+  return independent * (cylinder_rms * cylinder_rms - cone_rms * cone_rms) / (cone_rms * cone_rms) >
          kConeChiSquare;
 }
 
@@ -87,7 +95,7 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
     const auto as_cylinder = alternatives.screen(cylinderFromCone(fit.shape, points));
     const double cone_rms = alternatives.sampleRms(fit);
     if (as_cylinder && as_cylinder->rms < ratio * cone_rms &&
-        !coneSignificantlyBetter(cone_rms, as_cylinder->rms, points.size()))
+        !coneSignificantlyBetter(cone_rms, as_cylinder->rms, points.size(), p))
       if (const auto confirmed = alternatives.confirm(*as_cylinder))
         fit = *confirmed;
   }
@@ -101,7 +109,7 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
       const auto as_cone = alternatives.screen(start);
       if (as_cone &&
           (ratio * as_cone->rms < cylinder_rms ||
-           coneSignificantlyBetter(as_cone->rms, cylinder_rms, points.size())) &&
+           coneSignificantlyBetter(as_cone->rms, cylinder_rms, points.size(), p)) &&
           (!best_cone || as_cone->rms < best_cone->rms))
         best_cone = as_cone;
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "quadric_slam/frontend/parallel_chunks.h"
@@ -17,9 +18,19 @@ QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) 
   c.min_curved_points = std::max(4, p.min_curved_points / (d * d));
   c.planes.seed_stride = std::max(1, p.planes.seed_stride / d);
   c.planes.cell_size = p.planes.cell_size / d;
+  c.planes.correlated_points = std::max(1.0, p.planes.correlated_points / (d * d));
   c.cgal_stride = std::max(1, (p.cgal_stride + d / 2) / d);
   c.decimation = 1;
   return c;
+}
+
+pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNormal>& cloud, int d) {
+  pcl::PointCloud<pcl::PointNormal> grid(cloud.width / d, cloud.height / d);
+  grid.is_dense = false;
+  for (std::uint32_t r = 0; r < grid.height; ++r)
+    for (std::uint32_t c = 0; c < grid.width; ++c)
+      grid(c, r) = cloud(c * d, r * d);
+  return grid;
 }
 
 namespace {
@@ -161,7 +172,7 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
   for (int k = 0; k < n; ++k) {
     if (count[k] == 0)
       continue;
-    QuadricDetection detection = coarse.detections[k];
+    QuadricDetection detection = std::move(coarse.detections[k]);
     detection.label = static_cast<std::uint16_t>(result.detections.size() + 1);
     relabel[k + 1] = detection.label;
     // The covariance, sigma^2 (J^T J)^-1, follows the full-resolution support: J^T J grows with
@@ -179,10 +190,13 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
                              box[k].height - box[k].y_offset + 1};
     result.detections.push_back(std::move(detection));
   }
-  for (int v = 0; v < height; ++v) {
-    std::uint16_t* row = result.labels.ptr<std::uint16_t>(v);
-    for (int u = 0; u < width; ++u)
-      row[u] = relabel[row[u]];
+  // The labels change only when a detection was dropped (renumbering is the identity otherwise).
+  if (static_cast<int>(result.detections.size()) < n) {
+    for (int v = 0; v < height; ++v) {
+      std::uint16_t* row = result.labels.ptr<std::uint16_t>(v);
+      for (int u = 0; u < width; ++u)
+        row[u] = relabel[row[u]];
+    }
   }
   return result;
 }

@@ -137,7 +137,7 @@ Cell fitCell(const pcl::PointCloud<pcl::PointNormal>& cloud, const std::vector<s
   if (!fit.ok)
     return cell;
   const double count = cell.moments.count;
-  const double independent = std::max(1.0, count / kCorrelatedDepthPoints);
+  const double independent = std::max(1.0, count / params.correlated_points);
   cell.normal = fit.normal;
   cell.centroid = fit.centroid;
   // Covariance of theta, w_variance (X^T X)^-1 over the independent measurements; the normal's

@@ -88,6 +88,8 @@ void PlaneRegionGrower::Params::validate() const {
           "cell_size must be in [0, 64] pixels, got " + std::to_string(cell_size));
   require(cell_min_depth >= 0 && cell_min_depth <= 10,
           "cell_min_depth must be in [0, 10] m, got " + std::to_string(cell_min_depth));
+  require(correlated_points >= 1 && correlated_points <= 1000,
+          "correlated_points must be in [1, 1000], got " + std::to_string(correlated_points));
   require(fill_max_normal_angle >= 0 && fill_max_normal_angle < M_PI / 2,
           "fill_max_normal_angle must be in [0, pi/2) rad, got " +
               std::to_string(fill_max_normal_angle));
@@ -258,6 +260,7 @@ struct PlaneStats {
   double rms = 0;                   // RMS distance of the points to the plane (m)
   double spread1 = 0, spread2 = 0;  // in-plane variances of the points (m^2)
   double count = 0;
+  double correlated_points = 1;  // PlaneRegionGrower::Params::correlated_points
 
   void update() {
     count = moments.count;
@@ -277,8 +280,8 @@ struct PlaneStats {
   }
   // Mean expected variance of a point's distance to the plane (noise and bend, m^2).
   double noiseVariance() const { return sum_variance / count; }
-  // Independent measurements among the region's points (kCorrelatedDepthPoints).
-  double independent() const { return std::max(1.0, count / kCorrelatedDepthPoints); }
+  // Independent measurements among the region's points (Params::correlated_points).
+  double independent() const { return std::max(1.0, count / correlated_points); }
   // Variance of the plane's offset at x (m^2): the centroid's, and the normal's tilt about it.
   double offsetVariance(const Eigen::Vector3d& x) const {
     const double noise = noiseVariance() / independent();
@@ -303,6 +306,7 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::mergeCoplanar(
   std::vector<PlaneStats> stats(regions.size());
   for (std::size_t r = 0; r < regions.size(); ++r) {
     PlaneStats& st = stats[r];
+    st.correlated_points = params_.correlated_points;
     st.moments.reference = regions[r].plane.point;
     for (int k : regions[r].indices) {
       const pcl::PointNormal& q = cloud.points[k];

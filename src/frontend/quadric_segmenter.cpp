@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -41,6 +42,8 @@ void QuadricSegmenter::Params::validate() const {
           "decimation must be in [1, 8], got " + std::to_string(decimation));
   require(threads >= 1 && threads <= 64,
           "threads must be in [1, 64], got " + std::to_string(threads));
+  require(curved_decimation >= 1 && curved_decimation <= 8,
+          "curved_decimation must be in [1, 8], got " + std::to_string(curved_decimation));
   require(boundary_rings >= 0 && boundary_rings <= 10,
           "boundary_rings must be in [0, 10], got " + std::to_string(boundary_rings));
   planes.validate();
@@ -87,26 +90,12 @@ QuadricSegmenter::QuadricSegmenter(const Params& params) : params_(params) {
 
 namespace {
 
-// The segmentation proper, on the grid of the cloud it is given.
-Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
-                         const QuadricSegmenter::Params& p) {
-  Segmentation result;
-  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
-  result.labels = cv::Mat::zeros(height, width, CV_16UC1);
-  if (cloud.empty())
-    return result;
-
-  SegmentationFrame frame{cloud, width, height, std::vector<std::uint8_t>(cloud.size(), 0),
-              std::vector<std::uint8_t>(cloud.size(), 0)};
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const pcl::PointNormal& q = cloud.points[i];
-    frame.valid[i] = std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
-                     std::isfinite(q.normal_x) && std::isfinite(q.normal_y) &&
-                     std::isfinite(q.normal_z) && q.z >= p.min_range && q.z <= p.max_range;
-  }
-
-  const ShapeRefiner refiner(p.refiner);
-  auto accept = [&](const std::vector<int>& indices, const ShapeRefiner::Result& fit) {
+// Adds a detection with its support (pixels of frame's grid) to result: label, fit, support
+// statistics; marks the pixels used.
+AcceptDetection acceptInto(SegmentationFrame& frame, Segmentation& result) {
+  return [&frame, &result](const std::vector<int>& indices, const ShapeRefiner::Result& fit) {
+    const pcl::PointCloud<pcl::PointNormal>& cloud = frame.cloud;
+    const int width = frame.width;
     QuadricDetection detection;
     detection.shape = fit.shape;
     const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
@@ -140,6 +129,68 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
     }
     result.detections.push_back(std::move(detection));
   };
+}
+
+// The curved stages (2-3 of segmentGrid) on frame's grid decimated by p.curved_decimation, their
+// segments then labelled on frame's free points (multi_resolution_labels.h): detections and labels
+// on frame's grid. The used flags of frame are not changed.
+Segmentation segmentCurvedCoarser(const SegmentationFrame& frame, const QuadricSegmenter::Params& p,
+                                  const ShapeRefiner& refiner, SegmentationTimings& timings) {
+  const int c = p.curved_decimation;
+  const pcl::PointCloud<pcl::PointNormal> grid = decimated(frame.cloud, c);
+  const int width = static_cast<int>(grid.width), height = static_cast<int>(grid.height);
+  SegmentationFrame coarse_frame{grid, width, height, std::vector<std::uint8_t>(grid.size(), 0),
+                                 std::vector<std::uint8_t>(grid.size(), 0)};
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const int i = v * c * frame.width + u * c;
+      coarse_frame.valid[v * width + u] = frame.valid[i];
+      coarse_frame.used[v * width + u] = frame.used[i];
+    }
+  }
+  const QuadricSegmenter::Params coarse_params = coarseParams(p, c);
+  Segmentation coarse;
+  coarse.labels = cv::Mat::zeros(height, width, CV_16UC1);
+  auto start = std::chrono::steady_clock::now();
+  const CurvedCandidates candidates = findCurvedCandidates(coarse_frame, coarse_params);
+  timings.ransac_points = static_cast<int>(candidates.points.size());
+  timings.ransac_candidates = static_cast<int>(candidates.shapes.size());
+  timings.ransac_ms = msSince(start);
+  start = std::chrono::steady_clock::now();
+  verifyCurvedCandidates(coarse_frame, candidates, coarse_params, refiner,
+                         acceptInto(coarse_frame, coarse));
+  // The curved segments take only the free points of frame's grid: the others (planes, invalid)
+  // are hidden from the labelling.
+  pcl::PointCloud<pcl::PointNormal> free_points = frame.cloud;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < free_points.size(); ++i)
+    if (frame.used[i] || !frame.valid[i])
+      free_points.points[i].z = nan;
+  Segmentation curved = upsample(free_points, std::move(coarse), c, p);
+  timings.verify_ms = msSince(start);
+  return curved;
+}
+
+// The segmentation proper, on the grid of the cloud it is given.
+Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
+                         const QuadricSegmenter::Params& p) {
+  Segmentation result;
+  const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
+  result.labels = cv::Mat::zeros(height, width, CV_16UC1);
+  if (cloud.empty())
+    return result;
+
+  SegmentationFrame frame{cloud, width, height, std::vector<std::uint8_t>(cloud.size(), 0),
+                          std::vector<std::uint8_t>(cloud.size(), 0)};
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const pcl::PointNormal& q = cloud.points[i];
+    frame.valid[i] = std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
+                     std::isfinite(q.normal_x) && std::isfinite(q.normal_y) &&
+                     std::isfinite(q.normal_z) && q.z >= p.min_range && q.z <= p.max_range;
+  }
+
+  const ShapeRefiner refiner(p.refiner);
+  const AcceptDetection accept = acceptInto(frame, result);
 
   auto start = std::chrono::steady_clock::now();
   // 1. Planes from the image grid.
@@ -152,6 +203,27 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
 
   result.timings.planes_ms = msSince(start);
   start = std::chrono::steady_clock::now();
+
+  const int c = p.curved_decimation;
+  if (c > 1 && width >= 4 * c && height >= 4 * c) {
+    // 2-3. The curved stages on a coarser grid, whose cost grows with the samples; the planes
+    // stay on this one (a plane's extent and the merging of its fragments need it). Their labels
+    // follow the planes' in numbering.
+    Segmentation curved = segmentCurvedCoarser(frame, p, refiner, result.timings);
+    for (QuadricDetection& detection : curved.detections)
+      detection.label = static_cast<std::uint16_t>(detection.label + result.detections.size());
+    const auto offset = static_cast<std::uint16_t>(result.detections.size());
+    for (int v = 0; v < height; ++v) {
+      const std::uint16_t* from = curved.labels.ptr<std::uint16_t>(v);
+      std::uint16_t* to = result.labels.ptr<std::uint16_t>(v);
+      for (int u = 0; u < width; ++u)
+        if (from[u] != 0)
+          to[u] = static_cast<std::uint16_t>(from[u] + offset);
+    }
+    for (QuadricDetection& detection : curved.detections)
+      result.detections.push_back(std::move(detection));
+    return result;
+  }
 
   // 2. Curved candidates (curved_candidates.h).
   const CurvedCandidates candidates = findCurvedCandidates(frame, p);
@@ -183,7 +255,8 @@ Segmentation QuadricSegmenter::segment(const pcl::PointCloud<pcl::PointNormal>& 
   // least-squares part) is final.
   for (QuadricDetection& d : result.detections)
     if (d.shape.quadric_class == QuadricClass::kGeneral && d.covariance.rows() == 9)
-      d.covariance += ellipsoidModelCovariance(d.shape.general_quadric, params_.general_model_sigma);
+      d.covariance +=
+          ellipsoidModelCovariance(d.shape.general_quadric, params_.general_model_sigma);
   result.timings.boundary_ms = msSince(start);
   return result;
 }
@@ -197,11 +270,7 @@ Segmentation QuadricSegmenter::segmentWithNormals(
       cloud.height < static_cast<std::uint32_t>(4 * d))
     return segmentGrid(cloud, params_);
   const auto start = std::chrono::steady_clock::now();
-  pcl::PointCloud<pcl::PointNormal> grid(cloud.width / d, cloud.height / d);
-  grid.is_dense = false;
-  for (std::uint32_t r = 0; r < grid.height; ++r)
-    for (std::uint32_t c = 0; c < grid.width; ++c)
-      grid(c, r) = cloud(c * d, r * d);
+  const pcl::PointCloud<pcl::PointNormal> grid = decimated(cloud, d);
   const double decimate_ms = msSince(start);
   Segmentation coarse = segmentGrid(grid, coarseParams(params_, d));
   const auto upsample_start = std::chrono::steady_clock::now();

@@ -30,10 +30,6 @@ double kinectDepthSigma(double z, double noise_scale, double quantisation_factor
 // Its square, without the square root (per-point noise sums).
 double kinectDepthVariance(double z, double noise_scale, double quantisation_factor);
 
-// Neighbouring Kinect depths share the disparity matcher's window: N grid points of one surface
-// carry about N / kCorrelatedDepthPoints independent measurements (plane and cell uncertainties).
-constexpr double kCorrelatedDepthPoints = 16.0;
-
 class PlaneRegionGrower {
  public:
   struct Params {
@@ -96,6 +92,12 @@ class PlaneRegionGrower {
     // frames, refined ATE: no cells 2.58 cm, from 3 m 2.64, from 2 m 2.79): the mapper weighs far
     // planes by their noise and not yet by the sensor's systematic distortion. Default 3.
     double cell_min_depth = 3.0;
+    // Neighbouring depths of a structured-light sensor share its disparity matcher's window (the
+    // Kinect v1 correlates about 9 x 9 pixels): N points of one surface carry about N /
+    // correlated_points independent measurements (the noise of plane and cell fits). In points of
+    // the cloud grid, [1, 1000]: 64 on a full-resolution grid; a grid decimated by d holds
+    // 64 / d^2 of them (multi_resolution_labels.h coarseParams). Default 64.
+    double correlated_points = 64.0;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;

@@ -99,6 +99,7 @@ qs::PlaneRegionGrower::Params coarseGrowerParams(int cell_size, double cell_min_
   p.min_fragment_points = 25;
   p.seed_stride = 2;
   p.cell_size = cell_size;
+  p.correlated_points = 16;
   return p;
 }
 

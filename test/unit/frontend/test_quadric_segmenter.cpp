@@ -13,6 +13,7 @@
 #include <map>
 
 #include "primitive_desk_scene.h"
+#include "quadric_slam/frontend/multi_resolution_labels.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/io/frame_source.h"
@@ -64,12 +65,13 @@ double iou(const cv::Mat& labels, std::uint16_t label, const cv::Mat& truth, std
   return either ? static_cast<double>(both) / either : 0.0;
 }
 
-void checkScene(const Eigen::Isometry3d& T_camera_scene, unsigned seed) {
+void checkScene(const Eigen::Isometry3d& T_camera_scene, unsigned seed,
+                const qs::QuadricSegmenter::Params& params = qs::QuadricSegmenter::Params()) {
   const std::vector<qs::ScenePrimitive> scene = qs::test::primitiveDeskScene(T_camera_scene);
   qs::RenderParams render;
   render.seed = seed;
   const qs::PrimitiveRendering frame = qs::renderPrimitives(scene, kinect(), render);
-  const qs::QuadricSegmenter segmenter{qs::QuadricSegmenter::Params()};
+  const qs::QuadricSegmenter segmenter{params};
   const qs::Segmentation result = segmenter.segment(cloudWithNormals(frame.depth));
   // QS_DEBUG_DIR=dir writes the truth and the segmentation as pictures, and lists detections.
   if (const char* dir = std::getenv("QS_DEBUG_DIR")) {
@@ -158,11 +160,21 @@ TEST(QuadricSegmenter, FindsThemInATiltedView) {
   checkScene(T, 19);
 }
 
-TEST(QuadricSegmenter, LabelsAreConsistentWithDetections) {
+// The curved stages on a grid decimated once more (curved_decimation): the same surfaces, classes
+// and accuracy.
+TEST(QuadricSegmenter, FindsThemWithCurvedShapesOnACoarserGrid) {
+  qs::QuadricSegmenter::Params params;
+  params.curved_decimation = 2;
+  checkScene(Eigen::Isometry3d::Identity(), 7, params);
+}
+
+namespace {
+
+void checkLabelsConsistent(const qs::QuadricSegmenter::Params& params) {
   const qs::PrimitiveRendering frame = qs::renderPrimitives(
       qs::test::primitiveDeskScene(Eigen::Isometry3d::Identity()), kinect(), qs::RenderParams());
   const qs::Segmentation result =
-      qs::QuadricSegmenter(qs::QuadricSegmenter::Params()).segment(cloudWithNormals(frame.depth));
+      qs::QuadricSegmenter(params).segment(cloudWithNormals(frame.depth));
   ASSERT_FALSE(result.detections.empty());
   std::map<int, int> counts;
   for (int y = 0; y < result.labels.rows; ++y)
@@ -183,6 +195,20 @@ TEST(QuadricSegmenter, LabelsAreConsistentWithDetections) {
         }
     EXPECT_TRUE((d.extent_max.array() >= d.extent_min.array()).all());
   }
+}
+
+}  // namespace
+
+TEST(QuadricSegmenter, LabelsAreConsistentWithDetections) {
+  checkLabelsConsistent(qs::QuadricSegmenter::Params());
+}
+
+// Curved segments labelled from the coarser grid and planes from the finer one share one label
+// image and numbering.
+TEST(QuadricSegmenter, LabelsAreConsistentWithCurvedShapesOnACoarserGrid) {
+  qs::QuadricSegmenter::Params params;
+  params.curved_decimation = 2;
+  checkLabelsConsistent(params);
 }
 
 TEST(QuadricSegmenter, EmptyAllNanAndTinyCloudsGiveNoDetections) {
@@ -231,4 +257,21 @@ TEST(QuadricSegmenter, ParamsValidateNamesTheBadField) {
   p = qs::QuadricSegmenter::Params();
   p.curved_max_normal_angle = 2.0;
   expectNamed(p, "curved_max_normal_angle");
+  p = qs::QuadricSegmenter::Params();
+  p.curved_decimation = 0;
+  expectNamed(p, "curved_decimation");
+  p = qs::QuadricSegmenter::Params();
+  p.planes.correlated_points = 0.5;
+  expectNamed(p, "correlated_points");
+}
+
+// The plane statistics' correlated points are points of the grid: a grid decimated by d holds
+// 1 / d^2 of them (at least one), so a surface's noise does not change with the grid.
+TEST(QuadricSegmenter, CoarseGridParamsScaleTheCorrelatedDepthPoints) {
+  qs::QuadricSegmenter::Params p;
+  ASSERT_DOUBLE_EQ(p.planes.correlated_points, 64.0);
+  EXPECT_DOUBLE_EQ(qs::coarseParams(p, 2).planes.correlated_points, 16.0);
+  EXPECT_DOUBLE_EQ(qs::coarseParams(p, 4).planes.correlated_points, 4.0);
+  EXPECT_DOUBLE_EQ(qs::coarseParams(p, 8).planes.correlated_points, 1.0);
+  EXPECT_EQ(qs::coarseParams(p, 4).min_curved_points, p.min_curved_points / 16);
 }

@@ -17,20 +17,21 @@
 #include <set>
 #include <string>
 
+#include "../real_frames.h"
+#include "../test_data.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/io/segmentation_input.h"
-#include "../real_frames.h"
-#include "../test_data.h"
 
 namespace qs = quadric_slam;
 using qs::QuadricClass;
 
 namespace {
 
-qs::Segmentation segmentCloud(const pcl::PointCloud<pcl::PointXYZ>& cloud) {
+qs::Segmentation segmentCloud(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                              const qs::QuadricSegmenter::Params& params) {
   const auto with_normals = qs::NormalEstimator(qs::NormalEstimator::Params()).compute(cloud);
-  return qs::QuadricSegmenter(qs::QuadricSegmenter::Params()).segment(with_normals);
+  return qs::QuadricSegmenter(params).segment(with_normals);
 }
 
 // Per detection label, its pixels' overlap with each ground-truth label.
@@ -72,9 +73,7 @@ const std::map<std::string, std::set<int>> kUprightCylinders = {{"learn33", {50,
                                                                 {"learn43", {}},
                                                                 {"learn44", {30, 40, 41}}};
 
-}  // namespace
-
-TEST(QuadricSegmenterReal, OsdTablesArePlanesAndUprightCylindersAreCylinders) {
+void checkOsdTablesAndCylinders(const qs::QuadricSegmenter::Params& params) {
   const std::string dir = qs::test::sharedData("mosd_cylinders").string();
   QS_SKIP_WITHOUT_SHARED_DATA(dir, qs::test::kResearchUseOnly);
   int cylinders = 0, found = 0;
@@ -87,7 +86,7 @@ TEST(QuadricSegmenterReal, OsdTablesArePlanesAndUprightCylindersAreCylinders) {
       cloud.points[i].y = labelled.points[i].y;
       cloud.points[i].z = labelled.points[i].z;
     }
-    const qs::Segmentation result = segmentCloud(cloud);
+    const qs::Segmentation result = segmentCloud(cloud, params);
     Overlap overlap;
     for (std::size_t i = 0; i < labelled.size(); ++i) {
       const int d = result.labels.at<std::uint16_t>(static_cast<int>(i / labelled.width),
@@ -151,6 +150,12 @@ TEST(QuadricSegmenterReal, OsdTablesArePlanesAndUprightCylindersAreCylinders) {
   EXPECT_GE(found, 0.9 * cylinders);
 }
 
+}  // namespace
+
+TEST(QuadricSegmenterReal, OsdTablesArePlanesAndUprightCylindersAreCylinders) {
+  checkOsdTablesAndCylinders(qs::QuadricSegmenter::Params());
+}
+
 namespace {
 
 // Pixel (u, v) of a camera-frame point with the Freiburg3 intrinsics.
@@ -158,16 +163,14 @@ Eigen::Vector2d project(const Eigen::Vector3d& p) {
   return Eigen::Vector2d(535.4 * p.x() / p.z() + 320.1, 539.2 * p.y() / p.z() + 247.6);
 }
 
-}  // namespace
-
-TEST(QuadricSegmenterReal, Fr3GlobeIsASphereDeskTopAndFloorArePlanes) {
+void checkFr3GlobeDeskAndFloor(const qs::QuadricSegmenter::Params& params) {
   const std::string file = qs::test::shippedData(qs::test::kFr3HouseholdDepth).string();
   qs::CameraIntrinsics k;
   k.fx = 535.4;
   k.fy = 539.2;
   k.cx = 320.1;
   k.cy = 247.6;
-  const qs::Segmentation result = segmentCloud(qs::loadOrganizedCloud(file, k, 5000.0));
+  const qs::Segmentation result = segmentCloud(qs::loadOrganizedCloud(file, k, 5000.0), params);
 
   // The globe: a sphere in the top-left part of the image, of a globe's size.
   int globes = 0;
@@ -217,4 +220,17 @@ TEST(QuadricSegmenterReal, Fr3GlobeIsASphereDeskTopAndFloorArePlanes) {
     }
   }
   EXPECT_TRUE(desk) << "no desk-top plane parallel to the floor";
+}
+
+}  // namespace
+
+TEST(QuadricSegmenterReal, Fr3GlobeIsASphereDeskTopAndFloorArePlanes) {
+  checkFr3GlobeDeskAndFloor(qs::QuadricSegmenter::Params());
+}
+
+// The same with the curved stages on a grid decimated once more (curved_decimation).
+TEST(QuadricSegmenterReal, Fr3GlobeWithCurvedShapesOnACoarserGrid) {
+  qs::QuadricSegmenter::Params params;
+  params.curved_decimation = 2;
+  checkFr3GlobeDeskAndFloor(params);
 }

@@ -88,6 +88,8 @@ TEST(ConfigProfiles, QvgaProfileScalesTheFrontEndAndLeavesTheRest) {
   EXPECT_EQ(qvga.segmentation.decimation, 1);
   EXPECT_EQ(qvga.segmentation.planes.min_points * 4, base.segmentation.planes.min_points);
   EXPECT_EQ(qvga.segmentation.planes.cell_size * 2, base.segmentation.planes.cell_size);
+  EXPECT_DOUBLE_EQ(qvga.segmentation.planes.correlated_points * 4,
+                   base.segmentation.planes.correlated_points);
   EXPECT_EQ(qvga.odometry.icp.finest_stride * 2, base.odometry.icp.finest_stride);
   EXPECT_EQ(qvga.recovery.relocaliser.min_plane_points * 4,
             base.recovery.relocaliser.min_plane_points);
