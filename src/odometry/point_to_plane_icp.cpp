@@ -84,6 +84,8 @@ void PointToPlaneIcp::Params::validate() const {
           min_eigenvalue_ratio);
   require(noise_information_factor >= 0 && noise_information_factor <= 1000,
           "noise_information_factor", "[0, 1000]", noise_information_factor);
+  require(noise_information_min_depth >= 0 && noise_information_min_depth <= 100,
+          "noise_information_min_depth", "[0, 100] m", noise_information_min_depth);
   require(degenerate_variance > 0 && std::isfinite(degenerate_variance), "degenerate_variance",
           "(0, inf)", degenerate_variance);
   require(max_translation_from_guess > 0 && std::isfinite(max_translation_from_guess),
@@ -204,6 +206,7 @@ void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance
   const float min_cos = static_cast<float>(cos_max_normal_angle_);
   const double huber = params_.huber_delta;
   const bool noise_weighting = params_.depth_noise_weighting;
+  const float noise_min_depth = static_cast<float>(params_.noise_information_min_depth);
   // Upper triangle of H as 21 sums and b, accumulated in double.
   double h_acc[21] = {0};
   double noise_acc[21] = {0};
@@ -250,16 +253,18 @@ void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance
         h_acc[k++] += wji * J[j];
       b_acc[i] += wji * r;
     }
-    Eigen::Vector3f d = n_current - n;
-    d -= n.dot(d) * n;  // tangential: the tilt of one normal against the other
-    const Eigen::Vector3f pxd = p.cross(d);
-    const double Jd[6] = {d.x() * inv_s,   d.y() * inv_s,   d.z() * inv_s,
-                          pxd.x() * inv_s, pxd.y() * inv_s, pxd.z() * inv_s};
-    k = 0;
-    for (int i = 0; i < 6; ++i) {
-      const double wji = 0.5 * weight * Jd[i];
-      for (int j = i; j < 6; ++j)
-        noise_acc[k++] += wji * Jd[j];
+    if (ref.z >= noise_min_depth) {
+      Eigen::Vector3f d = n_current - n;
+      d -= n.dot(d) * n;  // tangential: the tilt of one normal against the other
+      const Eigen::Vector3f pxd = p.cross(d);
+      const double Jd[6] = {d.x() * inv_s,   d.y() * inv_s,   d.z() * inv_s,
+                            pxd.x() * inv_s, pxd.y() * inv_s, pxd.z() * inv_s};
+      k = 0;
+      for (int i = 0; i < 6; ++i) {
+        const double wji = 0.5 * weight * Jd[i];
+        for (int j = i; j < 6; ++j)
+          noise_acc[k++] += wji * Jd[j];
+      }
     }
     eq.weighted_sq += weight * r * r;
     ++eq.count;

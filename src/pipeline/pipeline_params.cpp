@@ -33,6 +33,7 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "min_correspondences", icp.min_correspondences, log);
   readParam(reader, "min_eigenvalue_ratio", icp.min_eigenvalue_ratio, log);
   readParam(reader, "noise_information_factor", icp.noise_information_factor, log);
+  readParam(reader, "noise_information_min_depth", icp.noise_information_min_depth, log);
   readParam(reader, "degenerate_variance", icp.degenerate_variance, log);
   readParam(reader, "max_translation_from_guess", icp.max_translation_from_guess, log);
   readParam(reader, "max_rotation_from_guess", icp.max_rotation_from_guess, log);
