@@ -83,12 +83,11 @@ class PointToPlaneIcp {
     // noise). Far planes (normal noise of 15-25 degrees at 3-4.5 m on a Kinect v1) then no longer
     // hold the pose along themselves. [0, 1000]; 0: the eigenvalue-ratio test alone.
     double noise_information_factor = 3.0;
-    // Only keyframe points at least this deep (m) add to that noise part. The normal estimator's
-    // window grows with the depth up to 2 m (depth_dependent_smoothing), which keeps the normals'
-    // noise small and about constant there; beyond it the noise grows with z. Nearer, two normals
-    // of one surface disagree mostly where the views differ (curved surfaces, edges, other pixels
-    // after a large step), which is geometry, not noise. [0, 100]
-    double noise_information_min_depth = 2.0;
+    // Only keyframe points at least this deep (m) add to that noise part. Nearer, the normal
+    // estimator's window (growing with the depth up to 2 m) keeps the normals' noise small, and two
+    // normals of one surface disagree mostly where the views differ (curved surfaces, edges, other
+    // pixels after a large step), which is geometry, not noise. [0, 100]
+    double noise_information_min_depth = 1.5;
     // Variance given to unconstrained directions in the covariance (m^2 or rad^2). > 0
     double degenerate_variance = 1.0;
     // A result further than this from the initial guess is implausible: lost (m, rad). > 0

@@ -71,19 +71,16 @@ INSTANTIATE_TEST_SUITE_P(
                            "tum_groundtruth/rgbd_dataset_freiburg1_desk-groundtruth.txt", 1.5, 20.0,
                            0.4}));
 
-// Known weak (issue 12, open). The room around the fr1_room path (room_fr1.yaml): where a far wall
-// (3-4.5 m) or the floor fills the view, the normals' noise (15-25 degrees there) passes for
-// information along the plane. Before the noise judgement (noise_information_factor) the tracker
-// said ok on 12 of 90 steps off by 5-47 cm at 3 Hz, 7 of 60 at 1.5 Hz (up to 29 cm), and at full
-// rate on 80 of the first 600 steps off by 2-16 cm (true steps 1-2 cm). With it, as shipped
-// (noise_information_min_depth 2 m): 2 of 90 (up to 17 cm), 1 of 60 (21 cm), and 5 of 600 above
-// 2 cm (up to 4.9 cm: ok frames right after a run of degenerate ones, whose poses had drifted along
-// the wall). With noise_information_min_depth 0 every case here passes (worst ok step 2.0 cm,
-// 2.4 cm, 0.7 cm; ok shares 0.34, 0.32, 0.41), but then the normals of near surfaces, which
-// disagree after large steps by geometry rather than noise, make 40-60% of the steps of the real
-// kitchen and of fr1_desk at 3 and 1.5 Hz degenerate. The min shares below are those runs'.
+// The room around the fr1_room path (room_fr1.yaml): where a far wall (3-4.5 m) or the floor fills
+// the view, the normals' noise (15-25 degrees there) used to pass for information along the plane:
+// the tracker said ok on 12 of 90 steps off by 5-47 cm at 3 Hz, 7 of 60 at 1.5 Hz (up to 29 cm),
+// and at full rate on 80 of the first 600 steps off by 2-16 cm (true steps 1-2 cm). Judged against
+// that noise (noise_information_factor) such views are degenerate: fewer frames are ok (measured
+// 0.36, 0.32 and 0.42 of them), none on a wrong step (worst 2.0 cm, 2.4 cm and 0.7 cm). The
+// full-rate case takes the first 20 s (the far-wall stretch at 8.6-14.3 s had the errors up to 16
+// cm): the whole 49 s take three minutes.
 INSTANTIATE_TEST_SUITE_P(
-    DISABLED_Fr1Room, SubsampledSequence,
+    Fr1Room, SubsampledSequence,
     ::testing::Values(Case{"fr1_room", "room_fr1.yaml",
                            "tum_groundtruth/rgbd_dataset_freiburg1_room-groundtruth.txt", 3.0, 30.0,
                            0.3},
@@ -92,7 +89,7 @@ INSTANTIATE_TEST_SUITE_P(
                            0.25},
                       Case{"fr1_room", "room_fr1.yaml",
                            "tum_groundtruth/rgbd_dataset_freiburg1_room-groundtruth.txt", 30.0,
-                           20.0, 0.3, 0.02}));
+                           20.0, 0.35, 0.02}));
 
 }  // namespace
 }  // namespace quadric_slam
