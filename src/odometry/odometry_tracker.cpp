@@ -32,6 +32,8 @@ void OdometryTracker::Params::validate() const {
     fail("increment_covariance_scale", "(0, 1e6]", increment_covariance_scale);
   if (!(increment_translation_fraction >= 0 && std::isfinite(increment_translation_fraction)))
     fail("increment_translation_fraction", "[0, inf)", increment_translation_fraction);
+  if (!(velocity_hold_time >= 0 && velocity_hold_time <= 10))
+    fail("velocity_hold_time", "[0, 10] s", velocity_hold_time);
   if (!(increment_rotation_per_metre >= 0 && std::isfinite(increment_rotation_per_metre)))
     fail("increment_rotation_per_metre", "[0, inf) rad/m", increment_rotation_per_metre);
   guess.validate();
@@ -46,7 +48,7 @@ void OdometryTracker::reset() {
   keyframe_observations_.clear();
   T_odom_keyframe_ = T_odom_camera_ = last_motion_ = Eigen::Isometry3d::Identity();
   keyframe_covariance_ = covariance_ = keyframe_relative_covariance_ = Matrix6::Zero();
-  last_dt_ = last_stamp_ = 0;
+  velocity_dt_ = velocity_stamp_ = last_stamp_ = 0;
   consecutive_lost_ = 0;
 }
 
@@ -167,7 +169,8 @@ OdometryTracker::Result OdometryTracker::track(
     setKeyframe(cloud, intrinsics, observations);
     initialized_ = true;
     last_motion_ = Eigen::Isometry3d::Identity();
-    last_dt_ = 0;
+    velocity_dt_ = 0;
+    velocity_stamp_ = stamp;
     last_stamp_ = stamp;
     consecutive_lost_ = 0;
     Result out = output(TrackingStatus::kOk, true);
@@ -181,7 +184,7 @@ OdometryTracker::Result OdometryTracker::track(
   const double dt = stamp - last_stamp_;
   Eigen::Isometry3d prediction = T_odom_camera_;
   if (params_.constant_velocity) {
-    const double k = (last_dt_ > 0 && dt > 0) ? std::clamp(dt / last_dt_, 0.0, 3.0) : 1.0;
+    const double k = (velocity_dt_ > 0 && dt > 0) ? std::clamp(dt / velocity_dt_, 0.0, 3.0) : 1.0;
     prediction =
         pose_math::orthonormalized(T_odom_camera_ * pose_math::scaleMotion(last_motion_, k));
   }
@@ -214,6 +217,7 @@ OdometryTracker::Result OdometryTracker::track(
     // Keep the last pose (no velocity: the motion is unknown) and grow the uncertainty.
     ++consecutive_lost_;
     last_motion_ = Eigen::Isometry3d::Identity();
+    velocity_dt_ = 0;
     covariance_ += Matrix6::Identity() * params_.icp.degenerate_variance;
     if (consecutive_lost_ >= params_.lost_frames_before_new_keyframe && usable()) {
       setKeyframe(cloud, intrinsics, observations);
@@ -244,10 +248,17 @@ OdometryTracker::Result OdometryTracker::track(
         (Vector6d() << st * st, st * st, st * st, sr * sr, sr * sr, sr * sr).finished();
     keyframe_relative_covariance_ = current_relative;
     // Only a step constrained in all six directions and accepted by the data sets the velocity;
-    // along a degenerate direction the motion is the prior's, which must not feed itself.
-    last_motion_ = icp.status == TrackingStatus::kOk
-                       ? pose_math::orthonormalized(previous.inverse() * T_odom_camera_)
-                       : Eigen::Isometry3d::Identity();
+    // along a degenerate direction the motion is the prior's, which must not feed itself. After a
+    // degenerate step the last confirmed velocity is kept (not this step's motion) while it is at
+    // most velocity_hold_time old: a hand-held camera keeps moving along a far wall that cannot
+    // measure it, and zero motion there is as wrong as a velocity carried for long.
+    if (icp.status == TrackingStatus::kOk) {
+      last_motion_ = pose_math::orthonormalized(previous.inverse() * T_odom_camera_);
+      velocity_dt_ = dt > 0 ? dt : 0;
+      velocity_stamp_ = stamp;
+    } else if (!(stamp - velocity_stamp_ <= params_.velocity_hold_time)) {
+      last_motion_ = Eigen::Isometry3d::Identity();
+    }
     const Eigen::Isometry3d& from_keyframe = icp.T_reference_current;
     if (from_keyframe.translation().norm() > params_.keyframe_translation ||
         pose_math::rotationAngle(from_keyframe) > params_.keyframe_rotation ||
@@ -256,7 +267,6 @@ OdometryTracker::Result OdometryTracker::track(
       new_keyframe = true;
     }
   }
-  last_dt_ = dt > 0 ? dt : 0;
   last_stamp_ = stamp;
   Result result = output(icp.status, new_keyframe);
   // (A lost frame keeps the pose: identity with the unknown motion's degenerate_variance.)

@@ -1,5 +1,7 @@
 #include "quadric_slam/odometry/point_to_plane_icp.h"
 
+#include "quadric_slam/odometry/constrained_directions.h"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
@@ -80,6 +82,10 @@ void PointToPlaneIcp::Params::validate() const {
           "[6, 1e7]", min_correspondences);
   require(min_eigenvalue_ratio > 0 && min_eigenvalue_ratio < 1, "min_eigenvalue_ratio", "(0, 1)",
           min_eigenvalue_ratio);
+  require(noise_information_factor >= 0 && noise_information_factor <= 1000,
+          "noise_information_factor", "[0, 1000]", noise_information_factor);
+  require(noise_information_min_depth >= 0 && noise_information_min_depth <= 100,
+          "noise_information_min_depth", "[0, 100] m", noise_information_min_depth);
   require(degenerate_variance > 0 && std::isfinite(degenerate_variance), "degenerate_variance",
           "(0, inf)", degenerate_variance);
   require(max_translation_from_guess > 0 && std::isfinite(max_translation_from_guess),
@@ -178,9 +184,13 @@ int PointToPlaneIcp::usablePoints(const Cloud& current) const {
 
 // Point-to-plane residual r = n_ref . (R p + t - q_ref) (the linearised ICP of Low 2004); with the
 // left perturbation p' <- p' + omega x p' + v its Jacobian is J = [n_ref ; p' x n_ref].
+// The noise part of H (constrained_directions.h): with n_ref = n_true + e, H holds J_e J_e^T,
+// J_e = [e ; p' x e]. The tangential difference d of the two normals (keyframe and rotated
+// current) has E[d d^T] = 2 E[e e^T] when both have the same noise, so it adds J_d J_d^T / 2.
 void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance,
                                  Normals& eq) const {
   eq.H.setZero();
+  eq.noise.setZero();
   eq.b.setZero();
   eq.weighted_sq = 0;
   eq.count = 0;
@@ -196,8 +206,10 @@ void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance
   const float min_cos = static_cast<float>(cos_max_normal_angle_);
   const double huber = params_.huber_delta;
   const bool noise_weighting = params_.depth_noise_weighting;
+  const float noise_min_depth = static_cast<float>(params_.noise_information_min_depth);
   // Upper triangle of H as 21 sums and b, accumulated in double.
   double h_acc[21] = {0};
+  double noise_acc[21] = {0};
   double b_acc[6] = {0};
   for (const Sample& s : samples_) {
     const Eigen::Vector3f p = R * s.p + t;
@@ -222,7 +234,8 @@ void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance
     if (diff.squaredNorm() > max_sq * growth * growth)
       continue;
     ++eq.near;
-    if (n.dot(R * s.n) < min_cos)
+    const Eigen::Vector3f n_current = R * s.n;
+    if (n.dot(n_current) < min_cos)
       continue;
     // Depth-noise normalisation: r and J divided by s = (z_ref / 1 m)^2 (sigma(z) ~ z^2).
     const float z_eff = std::max(ref.z, 0.5f);
@@ -240,14 +253,27 @@ void PointToPlaneIcp::accumulate(const Eigen::Isometry3d& T, double max_distance
         h_acc[k++] += wji * J[j];
       b_acc[i] += wji * r;
     }
+    if (ref.z >= noise_min_depth) {
+      Eigen::Vector3f d = n_current - n;
+      d -= n.dot(d) * n;  // tangential: the tilt of one normal against the other
+      const Eigen::Vector3f pxd = p.cross(d);
+      const double Jd[6] = {d.x() * inv_s,   d.y() * inv_s,   d.z() * inv_s,
+                            pxd.x() * inv_s, pxd.y() * inv_s, pxd.z() * inv_s};
+      k = 0;
+      for (int i = 0; i < 6; ++i) {
+        const double wji = 0.5 * weight * Jd[i];
+        for (int j = i; j < 6; ++j)
+          noise_acc[k++] += wji * Jd[j];
+      }
+    }
     eq.weighted_sq += weight * r * r;
     ++eq.count;
   }
   int k = 0;
   for (int i = 0; i < 6; ++i) {
     for (int j = i; j < 6; ++j, ++k) {
-      eq.H(i, j) = h_acc[k];
-      eq.H(j, i) = h_acc[k];
+      eq.H(i, j) = eq.H(j, i) = h_acc[k];
+      eq.noise(i, j) = eq.noise(j, i) = noise_acc[k];
     }
     eq.b(i) = b_acc[i];
   }
@@ -269,7 +295,6 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
 
   Eigen::Isometry3d T = pose_math::orthonormalized(T_reference_current_guess);
   Normals eq;
-  Eigen::SelfAdjointEigenSolver<Matrix6> eigen;
   bool finest_ok = false;
   sampleFinest(current);
   for (int level = params_.pyramid_levels - 1; level >= 0; --level) {
@@ -285,24 +310,12 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
       accumulate(T, max_distance, eq);
       if (eq.count < needed)
         break;
-      // Degeneracy: directions of H with too little information keep the prior (solution
-      // remapping); otherwise the full 6x6 normal equations H delta = -b are solved by LDLT.
-      eigen.compute(eq.H);
-      const Vector6 lambda = eigen.eigenvalues();  // ascending
-      const double threshold = params_.min_eigenvalue_ratio * lambda(5);
-      int constrained = 0;
-      for (int i = 0; i < 6; ++i)
-        constrained += lambda(i) > threshold ? 1 : 0;
-      Vector6 delta;
-      if (constrained == 6) {
-        delta = eq.H.ldlt().solve(-eq.b);
-      } else {
-        delta.setZero();
-        for (int i = 6 - constrained; i < 6; ++i) {
-          const Vector6 v = eigen.eigenvectors().col(i);
-          delta -= v * (v.dot(eq.b) / lambda(i));
-        }
-      }
+      // Degeneracy: directions with too little information, or no more than the normals' noise
+      // explains, keep the prior (solution remapping); otherwise the full 6x6 normal equations.
+      const ConstrainedDirections directions(eq.H, eq.noise, params_.min_eigenvalue_ratio,
+                                             params_.noise_information_factor);
+      const int constrained = directions.constrained();
+      const Vector6 delta = directions.step(eq.b);
       T = pose_math::retractLeft(delta, T);
       ++result.iterations;
       if (level == 0) {
@@ -311,20 +324,14 @@ PointToPlaneIcp::Result PointToPlaneIcp::align(const Cloud& current,
         result.projected_points = eq.projected;
         result.overlap_near_fraction = eq.projected > 0 ? double(eq.near) / eq.projected : 0.0;
         result.constrained_dof = constrained;
-        result.eigenvalue_ratio = lambda(5) > 0 ? std::max(0.0, lambda(0)) / lambda(5) : 0.0;
+        result.eigenvalue_ratio = directions.eigenvalueRatio();
+        result.information_over_noise = ConstrainedDirections::informationOverNoise(eq.H, eq.noise);
         const double dof = std::max(1, eq.count - 6);
         const double sigma2 = eq.weighted_sq / dof;
         result.rms_residual = std::sqrt(eq.weighted_sq / eq.count);
         // Covariance sigma^2 H^-1 of the Gauss-Newton estimate; unconstrained directions get the
         // degenerate_variance.
-        Matrix6 cov = Matrix6::Zero();
-        for (int i = 0; i < 6; ++i) {
-          const Vector6 v = eigen.eigenvectors().col(i);
-          const double var =
-              lambda(i) > threshold ? sigma2 / lambda(i) : params_.degenerate_variance;
-          cov += var * v * v.transpose();
-        }
-        result.covariance = cov;
+        result.covariance = directions.covariance(sigma2, params_.degenerate_variance);
       }
       if (delta.head<3>().norm() < params_.convergence_translation * convergence_scale &&
           delta.tail<3>().norm() < params_.convergence_rotation * convergence_scale)

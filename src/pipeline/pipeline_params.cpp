@@ -32,6 +32,8 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "convergence_rotation", icp.convergence_rotation, log);
   readParam(reader, "min_correspondences", icp.min_correspondences, log);
   readParam(reader, "min_eigenvalue_ratio", icp.min_eigenvalue_ratio, log);
+  readParam(reader, "noise_information_factor", icp.noise_information_factor, log);
+  readParam(reader, "noise_information_min_depth", icp.noise_information_min_depth, log);
   readParam(reader, "degenerate_variance", icp.degenerate_variance, log);
   readParam(reader, "max_translation_from_guess", icp.max_translation_from_guess, log);
   readParam(reader, "max_rotation_from_guess", icp.max_rotation_from_guess, log);
@@ -43,6 +45,7 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "keyframe_min_overlap", params.keyframe_min_overlap, log);
   readParam(reader, "constant_velocity", params.constant_velocity, log);
   readParam(reader, "zero_motion_start", params.zero_motion_start, log);
+  readParam(reader, "velocity_hold_time", params.velocity_hold_time, log);
   readParam(reader, "lost_frames_before_new_keyframe", params.lost_frames_before_new_keyframe, log);
   readParam(reader, "quadric_motion_guess", params.quadric_motion_guess, log);
   readParam(reader, "guess_min_translation", params.guess_min_translation, log);

@@ -57,6 +57,10 @@ class OdometryTracker {
     // constrained and the alignment accepted); after a degenerate or lost step the prior is the
     // last pose.
     bool zero_motion_start = true;
+    // After a degenerate step the prior keeps the last confirmed (ok) velocity while it is at most
+    // this old (s), along the directions the data could not constrain too; older, or after a lost
+    // step, the prior is the last pose. [0, 10]; 0: the last pose after every degenerate step.
+    double velocity_hold_time = 0.0;
     // The increment covariance (Result::increment_covariance) is ICP's sigma^2 H^-1 part times
     // increment_covariance_scale, (0, 1e6]: H^-1 counts every depth pixel as an independent
     // measurement, but real depth noise is correlated over neighbouring pixels and the
@@ -146,8 +150,10 @@ class OdometryTracker {
   // Covariance of the reported pose relative to the keyframe, T_keyframe_camera (right
   // perturbation, body tangent): zero when the reported pose is the keyframe's.
   Matrix6 keyframe_relative_covariance_ = Matrix6::Zero();
-  Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();  // T_prev_cur of the last step
-  double last_dt_ = 0;
+  // The velocity of the prior: T_prev_cur of the last ok step, its time span (0: none) and stamp.
+  Eigen::Isometry3d last_motion_ = Eigen::Isometry3d::Identity();
+  double velocity_dt_ = 0;
+  double velocity_stamp_ = 0;
   double last_stamp_ = 0;
   int consecutive_lost_ = 0;
 };

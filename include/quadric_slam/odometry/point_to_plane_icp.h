@@ -75,6 +75,19 @@ class PointToPlaneIcp {
     // A direction of H whose eigenvalue is below min_eigenvalue_ratio * largest eigenvalue is
     // unconstrained: the update leaves it at the prior and the status is degenerate. (0, 1)
     double min_eigenvalue_ratio = 1e-3;
+    // A direction is also unconstrained when H's information along it is at most
+    // noise_information_factor times what the keyframe normals' noise alone puts there
+    // (odometry/constrained_directions.h). That noise part is estimated at each correspondence
+    // from the disagreement of its two normals (the keyframe's and the rotated current one: two
+    // independent noisy estimates of one surface; half their squared difference is one normal's
+    // noise). Far planes (normal noise of 15-25 degrees at 3-4.5 m on a Kinect v1) then no longer
+    // hold the pose along themselves. [0, 1000]; 0: the eigenvalue-ratio test alone.
+    double noise_information_factor = 3.0;
+    // Only keyframe points at least this deep (m) add to that noise part. Nearer, the normal
+    // estimator's window (growing with the depth up to 2 m) keeps the normals' noise small, and two
+    // normals of one surface disagree mostly where the views differ (curved surfaces, edges, other
+    // pixels after a large step), which is geometry, not noise. [0, 100]
+    double noise_information_min_depth = 1.5;
     // Variance given to unconstrained directions in the covariance (m^2 or rad^2). > 0
     double degenerate_variance = 1.0;
     // A result further than this from the initial guess is implausible: lost (m, rad). > 0
@@ -121,6 +134,10 @@ class PointToPlaneIcp {
     // Smallest over largest eigenvalue of H at the finest level (1: evenly constrained, 0: a free
     // direction); compared with Params::min_eigenvalue_ratio.
     double eigenvalue_ratio = 0;
+    // The smallest ratio, over all directions, of H's information to the part of it the keyframe
+    // normals' noise explains (about 1 where the noise explains all of it); compared with
+    // Params::noise_information_factor.
+    double information_over_noise = 0;
     std::string message;  // why the status is not ok (empty when ok)
   };
 
@@ -153,6 +170,7 @@ class PointToPlaneIcp {
   };
   struct Normals {
     Matrix6 H;
+    Matrix6 noise;  // expected contribution of the keyframe normals' noise to H
     Vector6 b;
     double weighted_sq = 0;
     int count = 0;

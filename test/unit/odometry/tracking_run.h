@@ -35,7 +35,8 @@ struct TrackedFrame {
   bool from_guess = false, from_last_pose = false;
   int candidate_points = 0, projected_points = 0, correspondences = 0;
   double inlier_fraction = 0, overlap_inlier_fraction = 0, overlap_near_fraction = 0,
-         rms_residual = 0, eigenvalue_ratio = 0;
+         rms_residual = 0, eigenvalue_ratio = 0, information_over_noise = 0;
+  int constrained_dof = 0;
   // The step from the last frame whose pose the tracker stands by (not lost, or a new keyframe)
   // to this one: true size and the estimate's error against the truth.
   double true_step_m = 0, true_step_deg = 0;
@@ -83,7 +84,7 @@ inline void writeTrackingCsv(const TrackingRun& run, const std::string& name) {
   std::ofstream csv(std::string(dir) + "/" + name + ".csv");
   csv << "stamp,status,new_keyframe,from_guess,from_last_pose,candidate_points,projected_points,"
          "correspondences,inlier_fraction,overlap_inlier_fraction,overlap_near_fraction,rms_"
-         "residual,eigenvalue_ratio,"
+         "residual,eigenvalue_ratio,information_over_noise,constrained_dof,"
          "true_step_m,true_step_deg,step_error_m,step_error_deg,increment_nees,"
          "increment_sigma_t_m,increment_sigma_r_deg\n";
   for (const TrackedFrame& f : run.frames) {
@@ -91,9 +92,10 @@ inline void writeTrackingCsv(const TrackingRun& run, const std::string& name) {
         << f.from_guess << ',' << f.from_last_pose << ',' << f.candidate_points << ','
         << f.projected_points << ',' << f.correspondences << ',' << f.inlier_fraction << ','
         << f.overlap_inlier_fraction << ',' << f.overlap_near_fraction << ',' << f.rms_residual
-        << ',' << f.eigenvalue_ratio << ',' << f.true_step_m << ',' << f.true_step_deg << ','
-        << f.step_error_m << ',' << f.step_error_deg << ',' << f.increment_nees << ','
-        << f.increment_sigma_t_m << ',' << f.increment_sigma_r_deg << '\n';
+        << ',' << f.eigenvalue_ratio << ',' << f.information_over_noise << ',' << f.constrained_dof
+        << ',' << f.true_step_m << ',' << f.true_step_deg << ',' << f.step_error_m << ','
+        << f.step_error_deg << ',' << f.increment_nees << ',' << f.increment_sigma_t_m << ','
+        << f.increment_sigma_r_deg << '\n';
   }
 }
 
@@ -135,6 +137,8 @@ inline TrackingRun runTracker(FrameSource& source, const Trajectory& truth,
     f.overlap_near_fraction = result.icp.overlap_near_fraction;
     f.rms_residual = result.icp.rms_residual;
     f.eigenvalue_ratio = result.icp.eigenvalue_ratio;
+    f.information_over_noise = result.icp.information_over_noise;
+    f.constrained_dof = result.icp.constrained_dof;
     ++(result.status == TrackingStatus::kOk           ? run.ok
        : result.status == TrackingStatus::kDegenerate ? run.degenerate
                                                       : run.lost);
