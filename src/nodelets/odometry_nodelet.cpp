@@ -234,10 +234,11 @@ class OdometryNodelet : public nodelet::Nodelet {
     // covariance carries the tracker's increment covariance from the previous message
     // (OdometryTracker::Result::increment_covariance, [rho; phi] in this frame's body tangent) as
     // that of a velocity held over dt: Cov(twist) = Cov(increment) / dt^2; the mapping nodelet
-    // multiplies by dt^2 again. Without a previous pose (the first message) it is not estimated:
-    // a large diagonal (1e6) says so.
+    // multiplies by dt^2 again. Without a previous pose (the first message), and for a lost frame
+    // (the tracker knows nothing of the motion; the mapper then uses its own model, as offline),
+    // it is not estimated: a large diagonal (1e6) says so.
     const double dt = (stamp - last_pose_stamp_).toSec();
-    const bool twist_known = last_pose_valid_ && dt > 0;
+    const bool twist_known = last_pose_valid_ && dt > 0 && result.status != TrackingStatus::kLost;
     if (twist_known) {
       const Eigen::Isometry3d delta = last_pose_.inverse() * T;
       const Eigen::AngleAxisd aa(delta.linear());

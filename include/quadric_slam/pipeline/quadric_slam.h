@@ -70,7 +70,7 @@ struct SlamParams {
   // increment covariance (OdometryTracker::Result::increment_covariance, the increments of frames
   // the mapper did not take composed into the next one; across a loss of tracking the mapper's
   // own model); false: the mapper's fixed odometry_* noise model.
-  bool odometry_increment_covariance = true;
+  bool odometry_increment_covariance = false;
 
   // Throws std::invalid_argument naming the bad field (of whichever stage) and its range.
   void validate() const;
