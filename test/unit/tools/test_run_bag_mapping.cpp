@@ -145,5 +145,18 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
   const std::string pipelined_trajectory = contents(dir / "out_depth/trajectory.txt");
   EXPECT_FALSE(pipelined_trajectory.empty());
   EXPECT_EQ(contents(dir / "out_sequential/trajectory.txt"), pipelined_trajectory);
+  // The worker threads inside the stages (default 1 when pipelined, the configured 2 with
+  // --sequential above) change the time, not the result; out of range is a usage error.
+  const std::string threaded =
+      run("run_bag",
+          (dir / "sequence").string() + " --out " + (dir / "out_threads").string() +
+              " --quiet --no-rgb --stage-threads 2",
+          &code);
+  ASSERT_EQ(code, 0) << threaded;
+  EXPECT_EQ(contents(dir / "out_threads/trajectory.txt"), pipelined_trajectory);
+  run("run_bag",
+      (dir / "sequence").string() + " --out " + (dir / "out_bad").string() + " --stage-threads 0",
+      &code);
+  EXPECT_EQ(code, 2);
   fs::remove_all(dir);
 }
