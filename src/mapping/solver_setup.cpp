@@ -1,5 +1,7 @@
 #include "quadric_slam/mapping/solver_setup.h"
 
+#include "quadric_slam/mapping/schur_covariance.h"
+
 #include <Eigen/Cholesky>
 #include <utility>
 #include <vector>
@@ -19,6 +21,15 @@ ceres::Solver::Options landmarkSolverOptions(int max_iterations) {
 std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
                                                    const std::map<int, LandmarkBlock>& landmarks) {
   std::map<int, Eigen::MatrixXd> out;
+  // A window's poses (and landmarks tied by its marginalisation prior) make a dense part of a few
+  // dozen to a few hundred variables: the Schur complement on them is cheaper than a sparse QR of
+  // the whole Jacobian (kitchen, 300 frames: 3.6 ms per keyframe solve against 9.1 ms for
+  // ceres::Covariance with SPARSE_QR, the same covariances). A batch over hundreds of keyframes is
+  // not: its dense part would be too large, and ceres::Covariance takes it.
+  constexpr int kMaxSchurDenseSize = 300;
+  if (schurLandmarkCovariances(problem, landmarks, kMaxSchurDenseSize, &out))
+    return out;
+  out.clear();
   ceres::Covariance::Options options;
   options.algorithm_type = ceres::SPARSE_QR;
   options.num_threads = 1;

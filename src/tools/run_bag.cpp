@@ -99,7 +99,8 @@ int usage(const std::string& problem) {
   std::cerr
       << "run_bag: " << problem << "\n"
       << "usage: run_bag INPUT --out DIR [--odometry-only] [--gt GROUNDTRUTH] [--config DIR]\n"
-      << "               [--profile NAME|DIR] [--max-frames N] [--intrinsics fx,fy,cx,cy] [--quiet]\n"
+      << "               [--profile NAME|DIR] [--max-frames N] [--intrinsics fx,fy,cx,cy] "
+         "[--quiet]\n"
       << "               [--sample-every N] [--no-rgb] [--no-batch] [--seconds S] [--rate HZ]\n"
       << "               [--seed N] [--sequential] [--stage-threads N]\n"
       << "  INPUT: a TUM rosbag (.bag), a TUM folder (rgb.txt, depth.txt, depth/), or a scene\n"

@@ -3,8 +3,8 @@
 // and the mapper; the mapped trajectory is as accurate as the odometry, the map holds the scene's
 // primitives without duplicates or spurious landmarks, and the reconstruction is written.
 #include <gtest/gtest.h>
-#include <unistd.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
