@@ -12,6 +12,12 @@
 // N the expected noise part of H. That is the generalised eigenproblem H v = mu B v with
 // B = min_eigenvalue_ratio * lambda_max(H) I + noise_information_factor * N: directions with
 // mu <= 1 are unconstrained. With N = 0 it is the classic eigenvalue-ratio test.
+//
+// The update and covariance live on the orthogonal complement of the unconstrained directions, not
+// on the span of the constrained generalised eigenvectors: those are B-orthogonal to the
+// unconstrained ones, and B couples a translation along a surface with the rotation whose lever arm
+// moves the surface's points that way (the normals' noise is tangential). A step along them would
+// carry the camera along a far wall, several centimetres a frame, while nothing measures it.
 #pragma once
 
 #include <Eigen/Core>
@@ -29,10 +35,12 @@ class ConstrainedDirections {
 
   // Number of constrained directions, 0..6.
   int constrained() const { return constrained_; }
-  // The Gauss-Newton step solving H delta = -b along the constrained directions only; it is zero
-  // along the others, which keep the start (solution remapping, Zhang, Kaess & Singh 2016).
+  // The Gauss-Newton step solving H delta = -b on the orthogonal complement of the unconstrained
+  // directions; it is zero along those, which keep the start (solution remapping, Zhang, Kaess &
+  // Singh 2016).
   Vector6d step(const Vector6d& b) const;
-  // sigma2 H^-1 on the constrained directions and degenerate_variance along the others.
+  // sigma2 H^-1 on the constrained complement and degenerate_variance along the unconstrained
+  // directions (orthonormalised).
   Matrix6d covariance(double sigma2, double degenerate_variance) const;
   // Smallest over largest eigenvalue of H alone (1: evenly constrained, 0: a free direction).
   double eigenvalueRatio() const { return eigenvalue_ratio_; }
@@ -45,8 +53,12 @@ class ConstrainedDirections {
   static double informationOverNoise(const Matrix6d& H, const Matrix6d& noise_information);
 
  private:
-  Matrix6d V_;   // generalised eigenvectors (columns), V^T B V = I, V^T H V = diag(mu)
-  Vector6d mu_;  // ascending
+  Vector6d mu_;  // generalised eigenvalues, ascending
+  // Orthonormal basis (columns): the first 6 - constrained_ span the unconstrained generalised
+  // eigenvectors, the others their orthogonal complement.
+  Matrix6d Q_;
+  // Inverse of H restricted to the complement (Q_c^T H Q_c)^-1, in its top-left corner.
+  Matrix6d H_complement_inverse_;
   int constrained_ = 0;
   double eigenvalue_ratio_ = 0;
 };
