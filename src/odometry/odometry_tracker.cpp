@@ -34,6 +34,8 @@ void OdometryTracker::Params::validate() const {
     fail("increment_translation_fraction", "[0, inf)", increment_translation_fraction);
   if (!(velocity_hold_time >= 0 && velocity_hold_time <= 10))
     fail("velocity_hold_time", "[0, 10] s", velocity_hold_time);
+  if (!(velocity_min_information >= 0 && velocity_min_information <= 1000))
+    fail("velocity_min_information", "[0, 1000]", velocity_min_information);
   if (!(increment_rotation_per_metre >= 0 && std::isfinite(increment_rotation_per_metre)))
     fail("increment_rotation_per_metre", "[0, inf) rad/m", increment_rotation_per_metre);
   guess.validate();
@@ -252,7 +254,8 @@ OdometryTracker::Result OdometryTracker::track(
     // degenerate step the last confirmed velocity is kept (not this step's motion) while it is at
     // most velocity_hold_time old: a hand-held camera keeps moving along a far wall that cannot
     // measure it, and zero motion there is as wrong as a velocity carried for long.
-    if (icp.status == TrackingStatus::kOk) {
+    if (icp.status == TrackingStatus::kOk &&
+        icp.information_over_noise >= params_.velocity_min_information) {
       last_motion_ = pose_math::orthonormalized(previous.inverse() * T_odom_camera_);
       velocity_dt_ = dt > 0 ? dt : 0;
       velocity_stamp_ = stamp;
@@ -276,6 +279,7 @@ OdometryTracker::Result OdometryTracker::track(
   result.guess = std::move(out.guess);
   result.started_from_guess = out.started_from_guess;
   result.started_from_last_pose = out.started_from_last_pose;
+  result.T_odom_predicted = prediction;
   return result;
 }
 

@@ -46,6 +46,7 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "constant_velocity", params.constant_velocity, log);
   readParam(reader, "zero_motion_start", params.zero_motion_start, log);
   readParam(reader, "velocity_hold_time", params.velocity_hold_time, log);
+  readParam(reader, "velocity_min_information", params.velocity_min_information, log);
   readParam(reader, "lost_frames_before_new_keyframe", params.lost_frames_before_new_keyframe, log);
   readParam(reader, "quadric_motion_guess", params.quadric_motion_guess, log);
   readParam(reader, "guess_min_translation", params.guess_min_translation, log);
@@ -140,8 +141,8 @@ void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Par
   readParam(reader, "relocalisation_max_ambiguity", relocaliser.max_ambiguity, log);
   readParam(reader, "relocalisation_extent_margin", relocaliser.extent_margin, log);
   readParam(reader, "relocalisation_min_plane_points", relocaliser.min_plane_points, log);
-  readParam(reader, "relocalisation_max_angle_difference",
-            relocaliser.matcher.max_angle_difference, log);
+  readParam(reader, "relocalisation_max_angle_difference", relocaliser.matcher.max_angle_difference,
+            log);
   readParam(reader, "relocalisation_max_offset_difference",
             relocaliser.matcher.max_offset_difference, log);
   params.validate();

@@ -97,11 +97,16 @@ gt_dir="$QS_ROOT/../shared/data/tum_groundtruth"
 py=/usr/bin/python3
 o3d_script="$QS_ROOT/test/bench/open3d_odometry.py"
 
+sudo_cmd=""
+[ "$(id -u)" -eq 0 ] || sudo_cmd=sudo
 if [ "$open3d" -eq 1 ] && ! "$py" -c 'import open3d' 2>/dev/null; then
   echo "odometry_benchmark: installing python3-open3d" >&2
-  sudo_cmd=""
-  [ "$(id -u)" -eq 0 ] || sudo_cmd=sudo
   $sudo_cmd apt-get install -y --no-install-recommends python3-open3d >&2
+fi
+# step_errors.py needs numpy (python3-open3d brings it; without Open3D it may be missing).
+if ! "$py" -c 'import numpy' 2>/dev/null; then
+  echo "odometry_benchmark: installing python3-numpy" >&2
+  $sudo_cmd apt-get install -y --no-install-recommends python3-numpy >&2
 fi
 for tool in synth run_bag evaluate; do
   if [ ! -x "$QS_WS/devel/lib/quadric_slam/$tool" ]; then

@@ -61,6 +61,14 @@ class OdometryTracker {
     // this old (s), along the directions the data could not constrain too; older, or after a lost
     // step, the prior is the last pose. [0, 10]; 0: the last pose after every degenerate step.
     double velocity_hold_time = 0.0;
+    // An ok step sets the velocity only when the information along its weakest direction is at
+    // least this many times what the keyframe normals' noise explains
+    // (PointToPlaneIcp::Result::information_over_noise); a step that passes the degeneracy test
+    // only just (a floor and a surface at an angle to it, held apart along their common line by
+    // an edge) is kept but, like a degenerate one, leaves the last confirmed velocity in place: its
+    // error along that line must not be carried into the next frames by the prior. [0, 1000];
+    // 0: every ok step.
+    double velocity_min_information = 0.0;
     // The increment covariance (Result::increment_covariance) is ICP's sigma^2 H^-1 part times
     // increment_covariance_scale, (0, 1e6]: H^-1 counts every depth pixel as an independent
     // measurement, but real depth noise is correlated over neighbouring pixels and the
@@ -100,6 +108,9 @@ class OdometryTracker {
     QuadricMotionGuess guess;         // the surfaces' motion guess (found = false when not made)
     bool started_from_guess = false;  // ICP's result came from the guess, not the prior
     bool started_from_last_pose = false;  // ... from the last pose (zero motion), not the prior
+    // The constant-velocity prior's prediction of this frame's pose (the last pose when no
+    // confirmed velocity is held; identity for the first frame).
+    Eigen::Isometry3d T_odom_predicted = Eigen::Isometry3d::Identity();
   };
 
   explicit OdometryTracker(const Params& params);

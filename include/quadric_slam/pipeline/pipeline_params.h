@@ -27,7 +27,7 @@ void readNormalEstimationParams(const ParamReader& reader, BackProjectionParams&
 // min_correspondences, min_eigenvalue_ratio, noise_information_factor, noise_information_min_depth,
 // degenerate_variance, max_translation_from_guess, max_rotation_from_guess, keyframe_translation,
 // keyframe_rotation, keyframe_min_overlap, constant_velocity, velocity_hold_time,
-// lost_frames_before_new_keyframe, the motion guess (guess_*) and the increment covariance's
+// velocity_min_information, lost_frames_before_new_keyframe, the motion guess (guess_*) and the increment covariance's
 // calibration (increment_covariance_scale, increment_translation_fraction,
 // increment_rotation_per_metre).
 void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& params, ParamLog& log);

@@ -90,6 +90,8 @@ TEST(OdometryTracker, ParamsValidateNamesTheBadField) {
           "min_overlap_inlier_fraction");
   rejects([](OdometryTracker::Params& p) { p.icp.max_rms_residual = 0; }, "max_rms_residual");
   rejects([](OdometryTracker::Params& p) { p.icp.gate_growth_depth = 0; }, "gate_growth_depth");
+  rejects([](OdometryTracker::Params& p) { p.velocity_min_information = -1; },
+          "velocity_min_information");
   OdometryTracker::Params bad;
   bad.icp.pyramid_levels = 9;
   EXPECT_THROW(OdometryTracker tracker(bad), std::invalid_argument);
@@ -127,6 +129,34 @@ TEST(OdometryTracker, SmoothSequenceHasSmallDrift) {
   EXPECT_GT(last.covariance.trace(), run.results[1].covariance.trace());
   EXPECT_GT(last.covariance(0, 0), 0);
   EXPECT_LT(std::sqrt(last.covariance(0, 0)), 0.01);
+}
+
+// velocity_min_information gates which ok steps set the constant-velocity prior: with the bar off
+// (0) each frame's prediction is the last pose moved on by the last step (1.5 cm); with a bar no
+// step reaches it is the last pose itself (velocity_hold_time 0). Both track.
+TEST(OdometryTracker, OnlyStepsAboveTheInformationBarSetTheVelocity) {
+  const synthetic::Scene scene = synthetic::roomScene();
+  const CameraIntrinsics k = synthetic::vgaIntrinsics();
+  for (const double bar : {0.0, 1000.0}) {
+    OdometryTracker::Params params = sequenceParams();
+    params.velocity_min_information = bar;
+    OdometryTracker tracker(params);
+    const Eigen::Isometry3d T_world_first = groundTruth(0);
+    Eigen::Isometry3d previous = Eigen::Isometry3d::Identity();
+    for (int i = 0; i < 12; ++i) {
+      const Eigen::Isometry3d T_world_camera = groundTruth(3 * i);  // every third frame: 1.5 cm
+      const Eigen::Isometry3d truth = T_world_first.inverse() * T_world_camera;
+      auto cloud = synthetic::renderCloud(scene, T_world_camera, k, 2, 0.0015, 2000 + i);
+      const OdometryTracker::Result r = tracker.track(*cloud, k, i * kFrameTime);
+      ASSERT_EQ(r.status, TrackingStatus::kOk) << "bar " << bar << " frame " << i;
+      EXPECT_LT(translationError(r.T_odom_camera, truth), 5e-3) << "bar " << bar << " frame " << i;
+      if (i >= 2 && bar == 0.0)
+        EXPECT_GT(translationError(r.T_odom_predicted, previous), 0.01) << "frame " << i;
+      else if (i >= 1 && bar > 0.0)
+        EXPECT_TRUE(r.T_odom_predicted.isApprox(previous, 1e-9)) << "frame " << i;
+      previous = r.T_odom_camera;
+    }
+  }
 }
 
 // 300 noise-free frames (160 x 120, there and back along the path twice, 1.2 m): rotations stay on
