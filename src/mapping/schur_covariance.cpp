@@ -9,14 +9,6 @@ namespace quadric_slam {
 
 namespace {
 
-// Symmetrised copy; empty when not positive definite.
-Eigen::MatrixXd positiveDefinite(const Eigen::MatrixXd& m) {
-  const Eigen::MatrixXd symmetric = 0.5 * (m + m.transpose());
-  if (!symmetric.allFinite() || Eigen::LLT<Eigen::MatrixXd>(symmetric).info() != Eigen::Success)
-    return Eigen::MatrixXd();
-  return symmetric;
-}
-
 // Inverse of a symmetric positive definite matrix; false when it is not.
 bool invertSpd(const Eigen::MatrixXd& m, Eigen::MatrixXd* inverse) {
   const Eigen::LLT<Eigen::MatrixXd> llt(0.5 * (m + m.transpose()));
@@ -155,13 +147,13 @@ bool schurLandmarkCovariances(ceres::Problem* problem,
     Eigen::MatrixXd covariance = A[s];
     if (dense_size > 0)
       covariance.noalias() += B[s] * S_inverse * B[s].transpose();
-    const Eigen::MatrixXd checked = positiveDefinite(covariance);
+    const Eigen::MatrixXd checked = acceptedCovariance(covariance);
     if (checked.size() > 0)
       (*out)[sparse_ids[s]] = checked;
   }
   for (const auto& [id, offset] : dense_offset_of) {
     const int k = landmarks.at(id).minimal_size;
-    const Eigen::MatrixXd checked = positiveDefinite(S_inverse.block(offset, offset, k, k));
+    const Eigen::MatrixXd checked = acceptedCovariance(S_inverse.block(offset, offset, k, k));
     if (checked.size() > 0)
       (*out)[id] = checked;
   }

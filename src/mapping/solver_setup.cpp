@@ -18,6 +18,13 @@ ceres::Solver::Options landmarkSolverOptions(int max_iterations) {
   return options;
 }
 
+Eigen::MatrixXd acceptedCovariance(const Eigen::MatrixXd& covariance) {
+  const Eigen::MatrixXd symmetric = 0.5 * (covariance + covariance.transpose());
+  if (!symmetric.allFinite() || Eigen::LLT<Eigen::MatrixXd>(symmetric).info() != Eigen::Success)
+    return Eigen::MatrixXd();
+  return symmetric;
+}
+
 std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
                                                    const std::map<int, LandmarkBlock>& landmarks) {
   std::map<int, Eigen::MatrixXd> out;
@@ -42,13 +49,11 @@ std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   for (const auto& [id, block] : landmarks) {
     RowMajor c(block.minimal_size, block.minimal_size);
-    if (!covariance.GetCovarianceBlockInTangentSpace(block.parameters, block.parameters,
-                                                     c.data()) ||
-        !c.allFinite())
+    if (!covariance.GetCovarianceBlockInTangentSpace(block.parameters, block.parameters, c.data()))
       continue;
-    const Eigen::MatrixXd symmetric = 0.5 * (c + c.transpose());
-    if (Eigen::LLT<Eigen::MatrixXd>(symmetric).info() == Eigen::Success)
-      out[id] = symmetric;
+    const Eigen::MatrixXd accepted = acceptedCovariance(c);
+    if (accepted.size() > 0)
+      out[id] = accepted;
   }
   return out;
 }

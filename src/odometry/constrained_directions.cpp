@@ -16,8 +16,8 @@ ConstrainedDirections::ConstrainedDirections(const Matrix6d& H, const Matrix6d& 
   const Eigen::SelfAdjointEigenSolver<Matrix6d> plain(H, Eigen::EigenvaluesOnly);
   const Vector6d lambda = plain.eigenvalues();  // ascending
   eigenvalue_ratio_ = lambda(5) > 0 ? std::max(0.0, lambda(0)) / lambda(5) : 0.0;
-  Q_ = Matrix6d::Identity();
-  H_complement_inverse_.setZero();
+  complement_inverse_.setZero();
+  unconstrained_projector_ = Matrix6d::Identity();
   if (!(lambda(5) > 0) || !H.allFinite()) {
     mu_.setZero();
     constrained_ = 0;
@@ -34,43 +34,35 @@ ConstrainedDirections::ConstrainedDirections(const Matrix6d& H, const Matrix6d& 
   for (int i = 0; i < 6; ++i)
     constrained_ += mu_(i) > 1.0 ? 1 : 0;
   const int free = 6 - constrained_;
+  // An orthonormal basis whose first columns span the unconstrained eigenvectors (a full QR of
+  // them) and whose others span their orthogonal complement.
+  Matrix6d Q = Matrix6d::Identity();
   if (free > 0 && constrained_ > 0) {
-    // A full QR of the unconstrained eigenvectors: its first columns span them, the rest is the
-    // orthogonal complement.
-    const Eigen::Matrix<double, 6, Eigen::Dynamic> unconstrained =
+    const Eigen::Matrix<double, 6, Eigen::Dynamic> free_eigenvectors =
         general.eigenvectors().leftCols(free);
-    Q_ = Eigen::HouseholderQR<Eigen::Matrix<double, 6, Eigen::Dynamic>>(unconstrained)
-             .householderQ();
+    Q = Eigen::HouseholderQR<Eigen::Matrix<double, 6, Eigen::Dynamic>>(free_eigenvectors)
+            .householderQ();
   }
+  const Eigen::MatrixXd unconstrained = Q.leftCols(free);
+  unconstrained_projector_ = unconstrained * unconstrained.transpose();
   if (constrained_ > 0) {
-    const Eigen::MatrixXd complement = Q_.rightCols(constrained_);
+    const Eigen::MatrixXd complement = Q.rightCols(constrained_);
     const Eigen::MatrixXd restricted = complement.transpose() * H * complement;
-    H_complement_inverse_.topLeftCorner(constrained_, constrained_) =
-        restricted.ldlt().solve(Eigen::MatrixXd::Identity(constrained_, constrained_));
+    complement_inverse_ =
+        complement *
+        restricted.ldlt().solve(Eigen::MatrixXd::Identity(constrained_, constrained_)) *
+        complement.transpose();
   }
 }
 
 Vector6d ConstrainedDirections::step(const Vector6d& b) const {
-  if (constrained_ == 0)
-    return Vector6d::Zero();
-  // delta = -Q_c (Q_c^T H Q_c)^-1 Q_c^T b: Gauss-Newton on the complement Q_c.
-  const Eigen::MatrixXd complement = Q_.rightCols(constrained_);
-  const Eigen::VectorXd reduced = complement.transpose() * b;
-  return -complement * (H_complement_inverse_.topLeftCorner(constrained_, constrained_) * reduced);
+  // Gauss-Newton on the complement; zero along the unconstrained directions.
+  return -complement_inverse_ * b;
 }
 
 Matrix6d ConstrainedDirections::covariance(double sigma2, double degenerate_variance) const {
-  Matrix6d cov = Matrix6d::Zero();
-  const int free = 6 - constrained_;
-  if (constrained_ > 0) {
-    const Eigen::MatrixXd complement = Q_.rightCols(constrained_);
-    cov += sigma2 * complement * H_complement_inverse_.topLeftCorner(constrained_, constrained_) *
-           complement.transpose();
-  }
-  if (free > 0) {
-    const Eigen::MatrixXd unconstrained = Q_.leftCols(free);
-    cov += degenerate_variance * unconstrained * unconstrained.transpose();
-  }
+  const Matrix6d cov =
+      sigma2 * complement_inverse_ + degenerate_variance * unconstrained_projector_;
   return 0.5 * (cov + cov.transpose());
 }
 

@@ -20,6 +20,10 @@ struct LandmarkBlock {
   int minimal_size = 0;
 };
 
+// covariance symmetrised, or an empty matrix when it is not finite or not positive definite: the
+// test every landmark covariance passes before the map keeps it.
+Eigen::MatrixXd acceptedCovariance(const Eigen::MatrixXd& covariance);
+
 // The marginal covariances of `landmarks` (id -> block) in their minimal tangent spaces, symmetric
 // and positive definite; an id whose block Ceres cannot give (e.g. a gauge left free) is left out,
 // and all are when the problem is rank-deficient.

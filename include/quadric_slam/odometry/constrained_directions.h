@@ -54,11 +54,11 @@ class ConstrainedDirections {
 
  private:
   Vector6d mu_;  // generalised eigenvalues, ascending
-  // Orthonormal basis (columns): the first 6 - constrained_ span the unconstrained generalised
-  // eigenvectors, the others their orthogonal complement.
-  Matrix6d Q_;
-  // Inverse of H restricted to the complement (Q_c^T H Q_c)^-1, in its top-left corner.
-  Matrix6d H_complement_inverse_;
+  // With C an orthonormal basis of the complement of the unconstrained directions:
+  // K = C (C^T H C)^-1 C^T (step -K b, covariance sigma2 K) ...
+  Matrix6d complement_inverse_;
+  // ... and the orthogonal projector onto the unconstrained directions.
+  Matrix6d unconstrained_projector_;
   int constrained_ = 0;
   double eigenvalue_ratio_ = 0;
 };

@@ -67,11 +67,14 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
           " --seconds 4 --rate 10 --no-bag --seed 2 --threads 1",
       &code);
   ASSERT_EQ(code, 0);
-  const std::string runner =
-      run("run_bag",
-          (dir / "sequence").string() + " --out " + (dir / "out").string() + " --gt " +
-              (dir / "sequence/groundtruth.txt").string() + " --quiet",
-          &code);
+  // run_bag on the generated sequence, its outputs in dir / out.
+  const auto runBag = [&](const std::string& out, const std::string& options) {
+    return run("run_bag",
+               (dir / "sequence").string() + " --out " + (dir / out).string() + " " + options,
+               &code);
+  };
+  const std::string gt_option = " --gt " + (dir / "sequence/groundtruth.txt").string();
+  const std::string runner = runBag("out", gt_option + " --quiet");
   ASSERT_EQ(code, 0) << runner;
   std::printf("%s", runner.c_str());
   const double odometry_ate = valueAfter(runner, "ate_rmse_m");
@@ -118,11 +121,7 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
   };
   std::size_t points_rgb = 0, points_depth = 0;
   EXPECT_GT(colouredShare(dir / "out/reconstruction.pcd", &points_rgb), 0.95);
-  const std::string depth_only =
-      run("run_bag",
-          (dir / "sequence").string() + " --out " + (dir / "out_depth").string() + " --gt " +
-              (dir / "sequence/groundtruth.txt").string() + " --quiet --no-rgb",
-          &code);
+  const std::string depth_only = runBag("out_depth", gt_option + " --quiet --no-rgb");
   ASSERT_EQ(code, 0) << depth_only;
   EXPECT_EQ(colouredShare(dir / "out_depth/reconstruction.pcd", &points_depth), 0.0);
   EXPECT_EQ(points_depth, points_rgb);
@@ -132,11 +131,7 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
 
   // Pipelined (two frames ahead in the front end, each on its own thread) and --sequential give
   // the same trajectory, to the last digit.
-  const std::string sequential =
-      run("run_bag",
-          (dir / "sequence").string() + " --out " + (dir / "out_sequential").string() +
-              " --quiet --no-rgb --sequential",
-          &code);
+  const std::string sequential = runBag("out_sequential", "--quiet --no-rgb --sequential");
   ASSERT_EQ(code, 0) << sequential;
   const auto contents = [](const fs::path& path) {
     std::ifstream in(path);
@@ -147,16 +142,10 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
   EXPECT_EQ(contents(dir / "out_sequential/trajectory.txt"), pipelined_trajectory);
   // The worker threads inside the stages (default 1 when pipelined, the configured 2 with
   // --sequential above) change the time, not the result; out of range is a usage error.
-  const std::string threaded =
-      run("run_bag",
-          (dir / "sequence").string() + " --out " + (dir / "out_threads").string() +
-              " --quiet --no-rgb --stage-threads 2",
-          &code);
+  const std::string threaded = runBag("out_threads", "--quiet --no-rgb --stage-threads 2");
   ASSERT_EQ(code, 0) << threaded;
   EXPECT_EQ(contents(dir / "out_threads/trajectory.txt"), pipelined_trajectory);
-  run("run_bag",
-      (dir / "sequence").string() + " --out " + (dir / "out_bad").string() + " --stage-threads 0",
-      &code);
+  runBag("out_bad", "--stage-threads 0");
   EXPECT_EQ(code, 2);
   fs::remove_all(dir);
 }
