@@ -21,15 +21,7 @@ void BatchRecorder::record(const MapperFrameResult& result, const QuadricMapper&
   // The earlier observations of promoted candidates and of candidates that joined a landmark
   // (this frame's are in the keyframe copied above).
   const int this_frame = result.keyframe && !window.empty() ? window.back().frame_index : -1;
-  const MapUpdate& update = result.update;
-  for (std::size_t p = 0; p < update.promoted.size() && p < update.promoted_history.size(); ++p)
-    for (const CandidateObservation& o : update.promoted_history[p])
-      if (o.frame_index != this_frame)
-        addObservation(o.frame_index, {update.promoted[p], o.measurement});
-  for (const MapUpdate::Joined& joined : update.joined)
-    for (const CandidateObservation& o : joined.history)
-      if (o.frame_index != this_frame)
-        addObservation(o.frame_index, {joined.landmark_id, o.measurement});
+  recordPromotions(result.update, this_frame);
 
   // The window's latest estimates are the batch's starting point.
   for (const Keyframe& keyframe : window) {
@@ -38,6 +30,17 @@ void BatchRecorder::record(const MapperFrameResult& result, const QuadricMapper&
       keyframes_[it->second].T_map_camera = keyframe.T_map_camera;
   }
   recordMerges(result.merges);
+}
+
+void BatchRecorder::recordPromotions(const MapUpdate& update, int this_frame) {
+  for (std::size_t p = 0; p < update.promoted.size() && p < update.promoted_history.size(); ++p)
+    for (const CandidateObservation& o : update.promoted_history[p])
+      if (o.frame_index != this_frame)
+        addObservation(o.frame_index, {update.promoted[p], o.measurement});
+  for (const MapUpdate::Joined& joined : update.joined)
+    for (const CandidateObservation& o : joined.history)
+      if (o.frame_index != this_frame)
+        addObservation(o.frame_index, {joined.landmark_id, o.measurement});
 }
 
 void BatchRecorder::addObservation(int frame_index, const WindowObservation& observation) {

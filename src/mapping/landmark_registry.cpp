@@ -22,6 +22,17 @@ void setLandmarkExtent(QuadricLandmark* landmark, const ExtentBox& box) {
   landmark->extent_max = box.max;
 }
 
+// A candidate's estimate as a new landmark (no covariance until the window solves for it).
+QuadricLandmark landmarkFromCandidate(const QuadricCandidate& candidate, int id) {
+  QuadricLandmark landmark;
+  landmark.id = id;
+  landmark.quadric_map = candidate.quadric_map;
+  landmark.observations = candidate.observations;
+  landmark.last_observed = candidate.last_observed;
+  setLandmarkExtent(&landmark, candidate.extent);
+  return landmark;
+}
+
 // The measurement's box moved into the frame of `quadric_map` through the predicted pose.
 ExtentBox observedExtentIn(const QuadricMeasurement& measurement,
                            const Eigen::Isometry3d& T_map_camera, const QuadricModel& quadric_map) {
@@ -198,12 +209,7 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
         update.joined.push_back({joined, candidate.history});
         continue;
       }
-      QuadricLandmark landmark;
-      landmark.id = next_landmark_id_++;
-      landmark.quadric_map = candidate.quadric_map;
-      landmark.observations = candidate.observations;
-      landmark.last_observed = candidate.last_observed;
-      setLandmarkExtent(&landmark, candidate.extent);
+      const QuadricLandmark landmark = landmarkFromCandidate(candidate, next_landmark_id_++);
       relabel(candidate.id, MeasurementFate::kPromoted, landmark.id);
       update.promoted.push_back(landmark.id);
       update.promoted_history.push_back(candidate.history);
@@ -216,6 +222,30 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
       continue;
     }
     kept.push_back(std::move(candidate));
+  }
+  candidates_ = std::move(kept);
+  return update;
+}
+
+MapUpdate LandmarkRegistry::promoteObserved(int min_observations,
+                                            const Eigen::Isometry3d& T_map_camera) {
+  if (min_observations < 1)
+    throw std::invalid_argument(
+        "LandmarkRegistry::promoteObserved: min_observations must be >= 1, got " +
+        std::to_string(min_observations));
+  MapUpdate update;
+  std::vector<QuadricCandidate> kept;
+  for (QuadricCandidate& candidate : candidates_) {
+    if (candidate.observations < min_observations ||
+        otherClassLandmark(candidate.quadric_map, candidate.extent, T_map_camera) != 0 ||
+        sameSurfaceLandmark(candidate, T_map_camera) != 0) {
+      kept.push_back(std::move(candidate));
+      continue;
+    }
+    const QuadricLandmark landmark = landmarkFromCandidate(candidate, next_landmark_id_++);
+    update.promoted.push_back(landmark.id);
+    update.promoted_history.push_back(std::move(candidate.history));
+    landmarks_.emplace(landmark.id, landmark);
   }
   candidates_ = std::move(kept);
   return update;
@@ -254,8 +284,8 @@ int LandmarkRegistry::sameSurfaceLandmark(const QuadricCandidate& candidate,
 }
 
 int LandmarkRegistry::otherClassLandmark(const QuadricModel& observed,
-                                              const ExtentBox& observed_box,
-                                              const Eigen::Isometry3d& T_map_camera) const {
+                                         const ExtentBox& observed_box,
+                                         const Eigen::Isometry3d& T_map_camera) const {
   const QuadricAssociator::Params& p = associator_.params();
   if (p.cross_class_distance <= 0.0)
     return 0;

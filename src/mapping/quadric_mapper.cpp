@@ -134,10 +134,10 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
     }
     // Degenerate and lost frames report a variance (1 m^2 and more) no camera motion explains.
     increment_covariance =
-        has_frame_ ? boundIncrementCovariance(odometry.increment_covariance,
-                                              frame.stamp - last_stamp_, params_.max_camera_speed,
-                                              params_.max_camera_angular_speed)
-                   : Matrix6d(odometry.increment_covariance);
+        has_frame_
+            ? boundIncrementCovariance(odometry.increment_covariance, frame.stamp - last_stamp_,
+                                       params_.max_camera_speed, params_.max_camera_angular_speed)
+            : Matrix6d(odometry.increment_covariance);
   } else {
     increment_covariance = incrementCovariance(T_previous_this);
   }
@@ -339,6 +339,17 @@ void QuadricMapper::relocalise(const Eigen::Isometry3d& T_map_odom) {
   T_map_odom_relocalised_ = T_map_odom;
 }
 
+MapUpdate QuadricMapper::promoteObservedCandidates(int min_observations) {
+  if (localization_only_ || window_.keyframes().empty())
+    return MapUpdate();
+  MapUpdate update =
+      map_.promoteObserved(min_observations, window_.keyframes().back().T_map_camera);
+  for (std::size_t p = 0; p < update.promoted.size(); ++p)
+    for (const CandidateObservation& o : update.promoted_history[p])
+      window_.addObservation(o.frame_index, {update.promoted[p], o.measurement});
+  return update;
+}
+
 void QuadricMapper::setLocalizationOnly(bool on) {
   localization_only_ = on;
   map_.setPromotion(!on);
@@ -367,8 +378,7 @@ int addKeyframeToReconstruction(const FrameMeasurements& frame, const MapperFram
     const auto landmark = map.landmarks().find(id);
     if (landmark != map.landmarks().end())
       stored += reconstruction->addPoints(id, landmark->second.quadric_map, result.T_map_camera,
-                                          measurement.support_points,
-                                          measurement.support_colours);
+                                          measurement.support_points, measurement.support_colours);
   }
   return stored;
 }

@@ -35,4 +35,15 @@ RecoveryRelocalisation relocaliseWhileRecovering(
   return out;
 }
 
+MapUpdate takeTrackingLoss(TrackingRecovery* recovery, QuadricMapper* mapper) {
+  const TrackingRecovery::Params& params = recovery->params();
+  MapUpdate promotion;
+  if (!recovery->recovering() && params.promote_on_loss_min_observations > 0 &&
+      static_cast<int>(mapper->map().landmarks().size()) < params.min_map_landmarks)
+    promotion = mapper->promoteObservedCandidates(params.promote_on_loss_min_observations);
+  recovery->trackingLost(static_cast<int>(mapper->map().landmarks().size()),
+                         !promotion.promoted.empty());
+  return promotion;
+}
+
 }  // namespace quadric_slam

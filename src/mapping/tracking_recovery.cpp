@@ -25,20 +25,27 @@ void TrackingRecovery::Params::validate() const {
   check(min_map_landmarks >= 0,
         "min_map_landmarks must be >= 0, got " + std::to_string(min_map_landmarks));
   check(max_frames >= 0, "max_frames must be >= 0, got " + std::to_string(max_frames));
+  check(promote_on_loss_min_observations >= 0 && promote_on_loss_min_observations <= 1000,
+        "promote_on_loss_min_observations must be in [0, 1000], got " +
+            std::to_string(promote_on_loss_min_observations));
+  check(promoted_max_frames >= 1 && promoted_max_frames <= 100000,
+        "promoted_max_frames must be in [1, 100000], got " + std::to_string(promoted_max_frames));
   relocaliser.validate();
 }
 
 TrackingRecovery::TrackingRecovery(const Params& params)
     : params_((params.validate(), params)), relocaliser_(params.relocaliser) {}
 
-void TrackingRecovery::trackingLost(int map_landmarks) {
+void TrackingRecovery::trackingLost(int map_landmarks, bool promoted_at_loss) {
   anchored_frames_ = 0;
   verified_ = false;
   recovering_frames_ = 0;
   if (map_landmarks < params_.min_map_landmarks)
     return;  // nothing to anchor against, nothing to put out of place
-  if (!recovering_)
+  if (!recovering_) {
     ++losses_;
+    max_frames_ = promoted_at_loss ? params_.promoted_max_frames : params_.max_frames;
+  }
   recovering_ = true;
 }
 
@@ -52,7 +59,7 @@ void TrackingRecovery::frameMapped(int landmark_associations) {
   if (anchored_frames_ >= params_.confirm_frames) {
     recovering_ = false;
     ++recoveries_;
-  } else if (params_.max_frames > 0 && recovering_frames_ >= params_.max_frames) {
+  } else if (max_frames_ > 0 && recovering_frames_ >= max_frames_) {
     recovering_ = false;
     ++timeouts_;
   }

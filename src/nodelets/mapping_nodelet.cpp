@@ -417,7 +417,7 @@ class MappingNodelet : public nodelet::Nodelet {
       // The odometry lost track: its pose is the last one before the loss, not this frame's.
       // Nothing of the frame reaches the map; afterwards the mapper localises until the surfaces
       // anchor the pose again (mapping/tracking_recovery.h).
-      recovery_.trackingLost(static_cast<int>(mapper_->map().landmarks().size()));
+      takeTrackingLoss(&recovery_, mapper_.get());
       std::lock_guard<std::mutex> lock(stats_mutex_);
       ++stats_.frames_lost;
       return;
@@ -467,10 +467,10 @@ class MappingNodelet : public nodelet::Nodelet {
                        relocalisation.result.supporting_surfaces,
                        relocalisation.result.usable_observations, 1e3 * relocalisation.seconds);
         std::lock_guard<std::mutex> lock(stats_mutex_);
-        stats_.last_relocalisation = relocalisation.result.found
-                                         ? (relocalisation.reanchored ? "re-anchored"
-                                                                      : "found at the odometry's pose")
-                                         : relocalisation.result.message;
+        stats_.last_relocalisation =
+            relocalisation.result.found
+                ? (relocalisation.reanchored ? "re-anchored" : "found at the odometry's pose")
+                : relocalisation.result.message;
         stats_.relocalisation_ms.add(1e3 * relocalisation.seconds);
       }
     }
@@ -795,7 +795,7 @@ class MappingNodelet : public nodelet::Nodelet {
     bool recovering = false;
     int relocalisation_attempts = 0, relocalisations = 0;
     std::string last_relocalisation = "none";  // the latest attempt's outcome
-    RecentDurations relocalisation_ms{100};   // of the latest attempts
+    RecentDurations relocalisation_ms{100};    // of the latest attempts
     long observations = 0, observations_dropped = 0, total_to_landmarks = 0, total_promoted = 0;
     std::string last_drop_reason, last_observation_problem;
     FrameStats last;

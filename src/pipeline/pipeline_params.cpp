@@ -134,6 +134,9 @@ void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Par
   readParam(reader, "recovery_confirm_frames", params.confirm_frames, log);
   readParam(reader, "recovery_min_map_landmarks", params.min_map_landmarks, log);
   readParam(reader, "recovery_max_frames", params.max_frames, log);
+  readParam(reader, "recovery_promote_on_loss_min_observations",
+            params.promote_on_loss_min_observations, log);
+  readParam(reader, "recovery_promoted_max_frames", params.promoted_max_frames, log);
   Relocaliser::Params& relocaliser = params.relocaliser;
   readParam(reader, "relocalisation_enabled", relocaliser.enabled, log);
   readParam(reader, "relocalisation_min_supporting_surfaces", relocaliser.min_supporting_surfaces,

@@ -214,7 +214,9 @@ SlamFrameResult QuadricSlam::backEnd(FrontEndFrame* front) {
     // after the loss gets the mapper's own odometry model, as after a restart, and the recovery
     // (localising only, relocalisation) re-anchors it.
     increment_since_mapped_valid_ = false;
-    recovery_.trackingLost(static_cast<int>(mapper_.map().landmarks().size()));
+    const MapUpdate promotion = takeTrackingLoss(&recovery_, &mapper_);
+    if (params_.batch_refinement && !batch_overflow_)
+      batch_recorder_.recordPromotions(promotion);
     out.recovering = recovery_.recovering();
     out.message = "tracking lost: the mapper adds nothing from this frame";
     return out;

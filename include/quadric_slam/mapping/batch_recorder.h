@@ -48,6 +48,9 @@ class BatchRecorder {
   // joined candidates go to the recorded keyframes that made them; the estimates of the window's
   // keyframes are refreshed; then result.merges are applied.
   void record(const MapperFrameResult& result, const QuadricMapper& mapper);
+  // The observations of landmarks promoted (or joined) outside process()
+  // (QuadricMapper::promoteObservedCandidates), except those of frame index this_frame.
+  void recordPromotions(const MapUpdate& update, int this_frame = -1);
   // Merges made outside process() (QuadricMapper::mergeDuplicates), in their order.
   void recordMerges(const std::vector<LandmarkMerge>& merges);
   // Forgets everything (the mapper was reset).

@@ -111,6 +111,13 @@ class LandmarkRegistry {
   // in the new quadric frame. Throws std::out_of_range for an unknown id.
   void setEstimate(int id, const QuadricModel& quadric_map, const Eigen::MatrixXd& covariance);
   const std::vector<QuadricCandidate>& candidates() const { return candidates_; }
+  // Promotes at once every candidate seen in at least min_observations frames (>= 1) that is not
+  // a surface the map holds already (same class, or another class's landmark it lies on, in range
+  // of T_map_camera): the map's start after a loss of tracking that came before min_observations
+  // (mapping/tracking_recovery.h). Ignores promotion(); the update lists the new landmarks with the
+  // observations they came from (measurements is empty). Throws std::invalid_argument for
+  // min_observations < 1.
+  MapUpdate promoteObserved(int min_observations, const Eigen::Isometry3d& T_map_camera);
 
   // Adds a landmark known from elsewhere (a saved map) under its own id; landmarks promoted later
   // get larger ids. Throws std::invalid_argument when the id is < 1 or already in use, or the
@@ -145,7 +152,7 @@ class LandmarkRegistry {
   // overlapping) whose surface lies nearest to `observed` over the box `observed_box` (in
   // observed's frame), within association.cross_class_distance; 0 when none.
   int otherClassLandmark(const QuadricModel& observed, const ExtentBox& observed_box,
-                              const Eigen::Isometry3d& T_map_camera) const;
+                         const Eigen::Isometry3d& T_map_camera) const;
 
   Params params_;
   QuadricAssociator associator_;

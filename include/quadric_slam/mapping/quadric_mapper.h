@@ -156,6 +156,14 @@ class QuadricMapper {
   // std::invalid_argument when T_map_odom is not rigid.
   void relocalise(const Eigen::Isometry3d& T_map_odom);
 
+  // Tracking was lost before the map held landmarks enough to find the camera again
+  // (mapping/tracking_recovery.h): candidates seen in at least min_observations frames (>= 1)
+  // become landmarks now, their observations factors in the window keyframes that made them, so
+  // that the frames before the loss can be found again. Returns the update (new landmarks and
+  // their observations, for a BatchRecorder); empty in localisation-only mode or before the first
+  // keyframe.
+  MapUpdate promoteObservedCandidates(int min_observations);
+
   // Merges every pair of landmarks of the map that are the same surface, repeatedly until none
   // is left (call it before saving a map). Returns the merges in order; none in localisation-only
   // mode or with merging disabled.

@@ -5,10 +5,10 @@
 // the frame's surfaces with the landmarks it already has (nothing new is promoted, landmarks are
 // held fixed) until enough of them agree, in enough consecutive frames, that the pose is anchored
 // in the map again; then mapping resumes. With relocalisation enabled, frames count as anchoring
-// only after the relocaliser has confirmed the pose (poseVerified()). With too few landmarks to anchor against, mapping
-// resumes at once (there is nothing to put out of place). When the camera moved while the
-// odometry was blind, the odometry's pose associates with nothing: then the frame's surfaces are
-// matched against the map's landmarks with no pose prior (mapping/relocaliser.h,
+// only after the relocaliser has confirmed the pose (poseVerified()). With too few landmarks to
+// anchor against, mapping resumes at once (there is nothing to put out of place). When the camera
+// moved while the odometry was blind, the odometry's pose associates with nothing: then the frame's
+// surfaces are matched against the map's landmarks with no pose prior (mapping/relocaliser.h,
 // mapping/recovery_relocalisation.h), the odometry is re-anchored in the map at the relocalised
 // pose (relocalised()), and the anchoring and confirmation above run from there. With
 // relocalisation disabled, or when it finds nothing, it waits until the view returns, unless
@@ -37,6 +37,17 @@ class TrackingRecovery {
     // (the default) waits until the view returns to mapped surfaces. Resuming without an anchor
     // lets the map continue from the odometry's pose, so surfaces seen again may be mapped twice.
     int max_frames = 0;
+    // A loss before the map holds min_map_landmarks landmarks (the first frames of a run, before
+    // any candidate was seen min_observations times) would leave nothing to find the camera
+    // again: the map would go on from the odometry's restart pose, and everything before the loss
+    // would stay apart from the rest. So at such a loss the candidates seen in at least this many
+    // frames become landmarks (QuadricMapper::promoteObservedCandidates), and when that gives the
+    // map min_map_landmarks the recovery runs as after any loss, [0, 1000]; 0: off. Default 3.
+    int promote_on_loss_min_observations = 3;
+    // After such a promotion the recovery gives up after this many localising frames without an
+    // anchor (those few surfaces may never come into view again), and mapping goes on from the
+    // odometry's pose as it would without them, [1, 100000]. Default 60 (2 s at 30 Hz).
+    int promoted_max_frames = 60;
     // Relocalisation against the map while recovering (config/mapping.yaml relocalisation_*).
     Relocaliser::Params relocaliser;
 
@@ -48,7 +59,8 @@ class TrackingRecovery {
   explicit TrackingRecovery(const Params& params);
 
   // The odometry lost track in this frame (nothing of the frame reaches the mapper).
-  void trackingLost(int map_landmarks);
+  // promoted_at_loss: candidates were promoted because of this loss (promoted_max_frames applies).
+  void trackingLost(int map_landmarks, bool promoted_at_loss = false);
   // A frame the mapper has processed (localisation only while recovering): how many of its
   // observations associated with landmarks.
   void frameMapped(int landmark_associations);
@@ -81,6 +93,7 @@ class TrackingRecovery {
   bool verified_ = false;
   int anchored_frames_ = 0;
   int recovering_frames_ = 0;
+  int max_frames_ = 0;  // of the current recovery: max_frames or promoted_max_frames
   int losses_ = 0, recoveries_ = 0, timeouts_ = 0;
   int relocalisation_attempts_ = 0, relocalisations_ = 0;
 };

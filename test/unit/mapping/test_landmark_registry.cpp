@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <cstdio>
 #include <random>
+#include <set>
 
 #include "quadric_slam/geometry/surface_distance.h"
 #include "quadric_slam/mapping/landmark_registry.h"
@@ -190,6 +191,50 @@ TEST(LandmarkRegistry, CandidateOfALandmarksSurfaceJoinsIt) {
   }
 }
 
+// At a loss of tracking before the map has landmarks (mapping/tracking_recovery.h), candidates
+// seen often enough become landmarks at once, with the observations they came from; those seen
+// fewer times stay candidates, and so does one of a surface the map holds already.
+TEST(LandmarkRegistry, PromoteObservedTakesCandidatesSeenOftenEnoughOfNewSurfacesOnly) {
+  LandmarkRegistry map;
+  std::mt19937 rng(61);
+  const Eigen::Vector3d Z = Eigen::Vector3d::UnitZ(), X = Eigen::Vector3d::UnitX();
+  const test::TrueLandmark near = test::plane(Eigen::Vector3d(0.0, 0, 0), Z, X, 0.5, 1.0);
+  const test::TrueLandmark far = test::plane(Eigen::Vector3d(1.02, 0, 0), Z, X, 0.5, 1.0);
+  const test::TrueLandmark sphere = test::sphere(Eigen::Vector3d(0, 0.4, 0.3), 0.25);
+  const test::TrueLandmark cone =
+      test::cone(Eigen::Vector3d(0.3, 0.5, 0.8), -Eigen::Vector3d::UnitZ(), 0.3, 0.5);
+  // Two fragments of the floor z = 0 meeting at x = 0.5, a sphere, and a cone seen in two frames.
+  for (int frame = 0; frame < 3; ++frame) {
+    std::vector<QuadricMeasurement> seen = {test::measure(near, kCamera, rng),
+                                            test::measure(far, kCamera, rng),
+                                            test::measure(sphere, kCamera, rng)};
+    if (frame < 2)
+      seen.push_back(test::measure(cone, kCamera, rng));
+    map.integrate(frame, 0.1 * frame, seen, kCamera, Matrix6d::Zero());
+  }
+  ASSERT_TRUE(map.landmarks().empty());
+  ASSERT_EQ(map.candidates().size(), 4u);
+
+  EXPECT_THROW(map.promoteObserved(0, kCamera), std::invalid_argument);
+  const MapUpdate u = map.promoteObserved(3, kCamera);
+  // The first floor fragment and the sphere; the second fragment is the surface of the first.
+  ASSERT_EQ(u.promoted.size(), 2u);
+  ASSERT_EQ(u.promoted_history.size(), 2u);
+  EXPECT_TRUE(u.measurements.empty());
+  std::set<QuadricClass> classes;
+  for (std::size_t i = 0; i < u.promoted.size(); ++i) {
+    EXPECT_EQ(u.promoted_history[i].size(), 3u);
+    EXPECT_EQ(map.landmark(u.promoted[i]).observations, 3);
+    classes.insert(map.landmark(u.promoted[i]).quadric_map.quadricClass());
+  }
+  EXPECT_EQ(classes, (std::set<QuadricClass>{QuadricClass::kPlane, QuadricClass::kSphere}));
+  EXPECT_EQ(map.landmarks().size(), 2u);
+  ASSERT_EQ(map.candidates().size(), 2u) << "the second floor fragment and the cone";
+  for (const QuadricCandidate& candidate : map.candidates())
+    EXPECT_NE(candidate.quadric_map.quadricClass(), QuadricClass::kSphere);
+  EXPECT_TRUE(map.promoteObserved(3, kCamera).promoted.empty()) << "promoted twice";
+}
+
 // A band of a cone seen from one side (a lamp shade: half-angle 0.45 rad, 0.1-0.32 m from the
 // apex, 1.5 m from the camera). Its fit fixes the radius where the band is seen, hardly how it
 // splits into half-angle, apex height and axis tilt; with a depth camera's spatially correlated
@@ -199,7 +244,7 @@ TEST(LandmarkRegistry, CandidateOfALandmarksSurfaceJoinsIt) {
 // (the default) every one of them is the landmark's; counted per point
 // (correlated_noise_fraction 0) they fail the gate and become a second landmark of the surface.
 struct ConeBand {
-  QuadricModel measured;               // the band in the camera frame
+  QuadricModel measured;                // the band in the camera frame
   std::vector<Eigen::Vector3d> points;  // its visible points, camera frame
 };
 
@@ -207,8 +252,8 @@ ConeBand coneBandSeenFrom(const Eigen::Isometry3d& T_world_camera) {
   const Eigen::Vector3d apex(0.0, 0.0, 1.2), axis = -Eigen::Vector3d::UnitZ();
   const double half_angle = 0.45;
   ConeBand band;
-  band.measured = predictMeasurement(T_world_camera,
-                                     quadricFromShape(ConeShape{apex, axis, half_angle}));
+  band.measured =
+      predictMeasurement(T_world_camera, quadricFromShape(ConeShape{apex, axis, half_angle}));
   for (int i = 0; i < 40; ++i) {
     const double t = 0.1 + 0.22 * i / 39.0;
     for (int j = 0; j < 200; ++j) {
@@ -260,8 +305,8 @@ QuadricMeasurement coneMeasurement(const QuadricModel& z, const Eigen::MatrixXd&
 }
 
 TEST(LandmarkRegistry, ConeBandScatteringAlongItsWeakDirectionStaysOneLandmark) {
-  const Eigen::Isometry3d camera = test::lookAlong(Eigen::Vector3d(-1.4, -0.4, 1.6),
-                                                   Eigen::Vector3d(1.4, 0.4, -0.6));
+  const Eigen::Isometry3d camera =
+      test::lookAlong(Eigen::Vector3d(-1.4, -0.4, 1.6), Eigen::Vector3d(1.4, 0.4, -0.6));
   const ConeBand band = coneBandSeenFrom(camera);
   ASSERT_GT(band.points.size(), 3000u);
   const double rms = 0.004;  // m, the depth noise at 1.5 m
@@ -292,21 +337,20 @@ TEST(LandmarkRegistry, ConeBandScatteringAlongItsWeakDirectionStaysOneLandmark) 
     for (; frame <= 25; ++frame) {
       const double sign = frame % 2 == 0 ? 1.0 : -1.0;
       const QuadricModel z = band.measured.plusMinimal(sign * kScatter * weak_unit);
-      const MapUpdate u = map.integrate(frame, 0.1 * frame,
-                                        {coneMeasurement(z, C, band.points, rms)}, camera,
-                                        Matrix6d::Zero());
+      const MapUpdate u = map.integrate(
+          frame, 0.1 * frame, {coneMeasurement(z, C, band.points, rms)}, camera, Matrix6d::Zero());
       ++after_promotion;
       if (u.measurements[0].fate == MeasurementFate::kLandmark && u.measurements[0].id == id)
         ++to_the_landmark;
       max_d2 = std::max(max_d2, u.measurements[0].landmark_association.squared_error);
     }
-    std::printf("correlated_noise_fraction %.2f: factor %.1f, %d of %d frames to the landmark, "
-                "largest d2 %.1f (gate %.1f), %zu landmarks\n",
-                fraction,
-                associator.correlatedNoiseFactor(
-                    coneMeasurement(band.measured, C, band.points, rms)),
-                to_the_landmark, after_promotion, max_d2, associator.gate(QuadricClass::kCone),
-                map.landmarks().size());
+    std::printf(
+        "correlated_noise_fraction %.2f: factor %.1f, %d of %d frames to the landmark, "
+        "largest d2 %.1f (gate %.1f), %zu landmarks\n",
+        fraction,
+        associator.correlatedNoiseFactor(coneMeasurement(band.measured, C, band.points, rms)),
+        to_the_landmark, after_promotion, max_d2, associator.gate(QuadricClass::kCone),
+        map.landmarks().size());
     if (fraction > 0.0) {
       EXPECT_EQ(to_the_landmark, after_promotion);
       EXPECT_EQ(map.landmarks().size(), 1u) << "the band became a second landmark";

@@ -125,3 +125,35 @@ TEST(TrackingRecovery, RelocaliserParametersAreValidated) {
   params.relocaliser.max_ambiguity = 1.5;
   EXPECT_THROW(TrackingRecovery{params}, std::invalid_argument);
 }
+
+// A recovery that began with a promotion at the loss (the map's first landmarks, made from the
+// candidates of the frames before it) gives up after promoted_max_frames, whatever max_frames
+// says: those few surfaces may never come into view again. A later loss waits as configured.
+TEST(TrackingRecovery, ARecoveryOnLandmarksPromotedAtTheLossGivesUpAfterItsOwnLimit) {
+  TrackingRecovery::Params params;
+  params.max_frames = 0;  // wait for ever after an ordinary loss
+  params.promoted_max_frames = 5;
+  TrackingRecovery recovery(params);
+  recovery.trackingLost(4, /*promoted_at_loss=*/true);
+  ASSERT_TRUE(recovery.recovering());
+  for (int i = 0; i < 4; ++i)
+    recovery.frameMapped(0);
+  EXPECT_TRUE(recovery.recovering());
+  recovery.frameMapped(0);
+  EXPECT_FALSE(recovery.recovering());
+  EXPECT_EQ(recovery.timeouts(), 1);
+
+  recovery.trackingLost(10);
+  for (int i = 0; i < 100; ++i)
+    recovery.frameMapped(0);
+  EXPECT_TRUE(recovery.recovering()) << "an ordinary loss took the promoted limit";
+}
+
+TEST(TrackingRecovery, PromotionParametersAreValidated) {
+  TrackingRecovery::Params params;
+  params.promote_on_loss_min_observations = -1;
+  EXPECT_THROW(TrackingRecovery{params}, std::invalid_argument);
+  params = {};
+  params.promoted_max_frames = 0;
+  EXPECT_THROW(TrackingRecovery{params}, std::invalid_argument);
+}
