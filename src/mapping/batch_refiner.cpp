@@ -6,12 +6,15 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <memory>
 #include <stdexcept>
+#include <vector>
 
 #include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/mapping/factors.h"
+#include "quadric_slam/mapping/observation_noise_scale.h"
 #include "quadric_slam/mapping/solver_setup.h"
 
 namespace quadric_slam {
@@ -25,6 +28,50 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// One keyframe's observation of a landmark, and its residual block in the problem.
+struct ObservationTerm {
+  double* pose = nullptr;
+  double* landmark = nullptr;
+  const QuadricMeasurement* measurement = nullptr;
+  ceres::ResidualBlockId block = nullptr;
+};
+
+// (Re)adds every observation with its covariance times the variance factor.
+void addObservationBlocks(double factor, ceres::LossFunction* loss, ceres::Problem* problem,
+                          std::vector<ObservationTerm>* terms) {
+  for (ObservationTerm& term : *terms) {
+    if (term.block != nullptr)
+      problem->RemoveResidualBlock(term.block);
+    term.block = problem->AddResidualBlock(
+        QuadricObservationCost::Create(term.measurement->quadric_camera,
+                                       term.measurement->covariance * factor),
+        loss, term.pose, term.landmark);
+  }
+}
+
+// The whitened residual of an observation (before the robust loss) under the covariance its block
+// carries; false when it cannot be evaluated.
+bool whitenedResidual(const ceres::Problem& problem, const ObservationTerm& term,
+                      Eigen::VectorXd* r) {
+  r->resize(problem.GetCostFunctionForResidualBlock(term.block)->num_residuals());
+  double cost = 0.0;
+  return problem.EvaluateResidualBlock(term.block, false, &cost, r->data(), nullptr) &&
+         r->allFinite();
+}
+
+// The variance factor the residuals at the current parameters call for; `current` is the factor
+// the problem's blocks carry (residuals under the measured covariances are theirs scaled back).
+double estimateFactor(const ceres::Problem& problem, const std::vector<ObservationTerm>& terms,
+                      double current) {
+  std::vector<WhitenedResidual> residuals;
+  residuals.reserve(terms.size());
+  Eigen::VectorXd r;
+  for (const ObservationTerm& term : terms)
+    if (whitenedResidual(problem, term, &r))
+      residuals.push_back({static_cast<int>(r.size()), r.squaredNorm() * current});
+  return observationVarianceFactor(residuals);
+}
+
 }  // namespace
 
 void BatchRefiner::Params::validate() const {
@@ -32,6 +79,10 @@ void BatchRefiner::Params::validate() const {
     throw std::invalid_argument("BatchRefiner::Params::max_iterations must be in [1, 10000]");
   if (max_keyframes < 1 || max_keyframes > 1000000)
     throw std::invalid_argument("BatchRefiner::Params::max_keyframes must be in [1, 1000000]");
+  if (noise_rounds < 0 || noise_rounds > 10)
+    throw std::invalid_argument("BatchRefiner::Params::noise_rounds must be in [0, 10]");
+  if (!(noise_tolerance > 0.0 && noise_tolerance <= 10.0))
+    throw std::invalid_argument("BatchRefiner::Params::noise_tolerance must be in (0, 10]");
 }
 
 BatchRefiner::BatchRefiner(const Params& params) : params_(params) {
@@ -109,7 +160,7 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
 
   // Landmarks and every keyframe observation of them.
   std::map<int, QuadricBlock> landmarks;
-  std::vector<ceres::ResidualBlockId> observation_blocks;
+  std::vector<ObservationTerm> observations;
   for (std::size_t i = 0; i < keyframes.size(); ++i) {
     for (const WindowObservation& observation : keyframes[i].observations) {
       const int id = observation.landmark_id;
@@ -119,39 +170,54 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
       }
       auto it = landmarks.find(id);
       if (it == landmarks.end()) {
-        const QuadricModel& quadric = map.landmark(id).quadric_map;
         it = landmarks.emplace(id, QuadricBlock{}).first;
-        quadricToParameters(quadric, it->second.data());
-        auto& manifold = quadric_manifolds[quadric.quadricClass()];
+        quadricToParameters(map.landmark(id).quadric_map, it->second.data());
+        const QuadricClass quadric_class = map.landmark(id).quadric_map.quadricClass();
+        auto& manifold = quadric_manifolds[quadric_class];
         if (!manifold)
-          manifold = std::make_unique<QuadricManifold>(quadric.quadricClass());
+          manifold = std::make_unique<QuadricManifold>(quadric_class);
         problem.AddParameterBlock(it->second.data(), kQuadricParameterSize, manifold.get());
         if (fixed(id)) {
           problem.SetParameterBlockConstant(it->second.data());
           ++stats.fixed_landmarks;
         }
       }
-      observation_blocks.push_back(problem.AddResidualBlock(
-          QuadricObservationCost::Create(observation.measurement.quadric_camera,
-                                         observation.measurement.covariance),
-          huber.get(), poses[i].data(), it->second.data()));
+      observations.push_back({poses[i].data(), it->second.data(), &observation.measurement});
       ++stats.observation_factors;
     }
   }
   stats.landmarks = static_cast<int>(landmarks.size());
+  double factor = 1.0;
+  addObservationBlocks(factor, huber.get(), &problem, &observations);
 
-  // The paper's batch solver: dog-leg.
+  // The paper's batch solver: dog-leg; solved again while the observations' variance factor,
+  // re-estimated at each solution, still changes.
   ceres::Solver::Options options = landmarkSolverOptions(params_.max_iterations);
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::DOGLEG;
   options.dogleg_type = ceres::TRADITIONAL_DOGLEG;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  stats.iterations = static_cast<int>(summary.iterations.size());
-  stats.initial_cost = summary.initial_cost;
-  stats.final_cost = summary.final_cost;
-  stats.solution_usable = summary.IsSolutionUsable();
-  stats.report = summary.BriefReport();
+  const int solves = std::max(1, params_.noise_rounds);
+  for (int round = 0; round < solves; ++round) {
+    if (params_.noise_rounds > 0) {
+      const double estimated = estimateFactor(problem, observations, factor);
+      if (round > 0 && std::abs(estimated / factor - 1.0) <= params_.noise_tolerance)
+        break;
+      factor = estimated;
+      addObservationBlocks(factor, huber.get(), &problem, &observations);
+    }
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, &problem, &summary);
+    ++stats.solves;
+    stats.iterations += static_cast<int>(summary.iterations.size());
+    if (round == 0)
+      stats.initial_cost = summary.initial_cost;
+    stats.final_cost = summary.final_cost;
+    stats.solution_usable = summary.IsSolutionUsable();
+    stats.report = summary.BriefReport();
+    if (!stats.solution_usable)
+      break;
+  }
+  stats.observation_variance_factor = factor;
   stats.solve_seconds = secondsSince(start);
   if (!stats.solution_usable) {
     solution.trajectory = reattachFrames(recorder, solution.keyframe_poses);
@@ -161,12 +227,10 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
   for (std::size_t i = 0; i < keyframes.size(); ++i)
     solution.keyframe_poses[i] = poseFromParameters(poses[i].data());
   std::vector<double> norms;
-  for (ceres::ResidualBlockId id : observation_blocks) {
-    Eigen::VectorXd r(problem.GetCostFunctionForResidualBlock(id)->num_residuals());
-    double cost = 0.0;
-    if (problem.EvaluateResidualBlock(id, false, &cost, r.data(), nullptr))
+  Eigen::VectorXd r;
+  for (const ObservationTerm& term : observations)
+    if (whitenedResidual(problem, term, &r))
       norms.push_back(r.norm());
-  }
   if (!norms.empty()) {
     std::sort(norms.begin(), norms.end());
     stats.observation_residual_median = norms[norms.size() / 2];

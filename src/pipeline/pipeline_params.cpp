@@ -157,6 +157,8 @@ void readBatchRefinementParams(const ParamReader& reader, bool& enabled,
   readParam(reader, "batch_max_iterations", params.max_iterations, log);
   readParam(reader, "batch_max_keyframes", params.max_keyframes, log);
   readParam(reader, "batch_compute_covariance", params.compute_covariance, log);
+  readParam(reader, "batch_noise_rounds", params.noise_rounds, log);
+  readParam(reader, "batch_noise_tolerance", params.noise_tolerance, log);
   params.validate();
 }
 

@@ -268,6 +268,8 @@ std::vector<qs::QuadricLandmark> refineOffline(const qs::QuadricSlam& slam, std:
   std::printf("batch_report %s\n", s.report.c_str());
   std::printf("batch observation residual (sigmas) median %.2f p95 %.2f\n",
               s.observation_residual_median, s.observation_residual_p95);
+  std::printf("batch observation variance factor %.1f (%d solves)\n", s.observation_variance_factor,
+              s.solves);
   if (!s.solution_usable) {
     std::printf("batch_refinement not usable (%s): the online estimates are kept\n",
                 s.report.c_str());
@@ -284,8 +286,15 @@ std::vector<qs::QuadricLandmark> refineOffline(const qs::QuadricSlam& slam, std:
   std::map<int, qs::QuadricLandmark> refined_by_id;
   for (const qs::QuadricLandmark& landmark : solution.landmarks)
     refined_by_id[landmark.id] = landmark;
-  std::printf("batch duplicate pairs %zu\ntrajectory_online %s\n",
-              slam.mapper().map().merger().findDuplicates(refined_by_id).size(), online.c_str());
+  const std::vector<qs::DuplicatePair> pairs =
+      slam.mapper().map().merger().findDuplicates(refined_by_id);
+  std::map<std::string, int> pairs_per_class;
+  for (const qs::DuplicatePair& pair : pairs)
+    ++pairs_per_class[qs::toString(refined_by_id.at(pair.id_a).quadric_map.quadricClass())];
+  std::printf("batch duplicate pairs %zu", pairs.size());
+  for (const auto& [name, count] : pairs_per_class)
+    std::printf(" %s %d", name.c_str(), count);
+  std::printf("\ntrajectory_online %s\n", online.c_str());
   return solution.landmarks;
 }
 

@@ -8,6 +8,10 @@
 //     (observation_huber), landmarks held fixed one by one (a loaded, trusted map) constant
 //     (the localisation-only mode, also used while recovering from a loss of tracking, is not),
 //   - the gauge: the first keyframe held fixed (it defines the map frame).
+// The observations' covariances are first multiplied by a variance factor estimated from their own
+// whitened residuals (mapping/observation_noise_scale.h), at the online estimates and again at each
+// solution until it settles (at most noise_rounds solves): the segments' fit covariances describe
+// pixel noise, not the scatter of a surface's observations between views.
 // No marginalisation prior and no landmark re-entry prior: every factor they summarised is in the
 // problem itself. Solved with the dog-leg trust region (ceres::DOGLEG, as the paper) for at most
 // max_iterations iterations, starting from the online estimates.
@@ -48,6 +52,10 @@ struct BatchStatistics {
   // Whitened observation residual norms at the solution (sigmas, before the robust loss): how
   // well the measurement covariances describe the data (about sqrt(k) when they do).
   double observation_residual_median = 0.0, observation_residual_p95 = 0.0;
+  // Variance factor the observation covariances were multiplied by (>= 1; 1 when the estimation
+  // is off), and the solves it took.
+  double observation_variance_factor = 1.0;
+  int solves = 0;
   double solve_seconds = 0.0, covariance_seconds = 0.0;  // wall time
 };
 
@@ -77,6 +85,12 @@ class BatchRefiner {
     // Marginal covariances of the refined landmarks (ceres::Covariance over the whole problem);
     // false, or when they cannot be computed: the online covariances stay.
     bool compute_covariance = true;
+    // Solves with a re-estimated observation variance factor: estimated at the online estimates,
+    // then again at each solution, the problem solved again while it changed by more than
+    // noise_tolerance (relative). 0 = off (the covariances as measured). int in [0, 10]; double
+    // in (0, 10].
+    int noise_rounds = 3;
+    double noise_tolerance = 0.1;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;

@@ -30,7 +30,8 @@ struct RecordedRun {
 // The mapper over `poses` with drifting odometry, every result recorded; the whole-map merge
 // before saving is recorded too.
 RecordedRun runAndRecord(QuadricMapper* mapper, const std::vector<test::TrueLandmark>& world,
-                         const std::vector<Eigen::Isometry3d>& poses, int seed) {
+                         const std::vector<Eigen::Isometry3d>& poses, int seed,
+                         double noise_scale = 1.0) {
   std::mt19937 rng(seed);
   const std::vector<Eigen::Isometry3d> odometry = test::driftingOdometry(poses, rng);
   RecordedRun out;
@@ -39,7 +40,7 @@ RecordedRun runAndRecord(QuadricMapper* mapper, const std::vector<test::TrueLand
     frame.stamp = 1.0 + i / 30.0;
     for (const test::TrueLandmark& l : world)
       if (test::visible(l, poses[i]))
-        frame.observations.push_back(test::measure(l, poses[i], rng));
+        frame.observations.push_back(test::measure(l, poses[i], rng, noise_scale));
     OdometryInput odom;
     odom.T_odom_camera = odometry[i];
     const MapperFrameResult r = mapper->process(frame, odom);
@@ -58,6 +59,12 @@ TEST(BatchRefiner, ParamsValidate) {
   BatchRefiner::Params p;
   EXPECT_NO_THROW(p.validate());
   p.max_keyframes = 0;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = {};
+  p.noise_rounds = 11;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = {};
+  p.noise_tolerance = 0.0;
   EXPECT_THROW(p.validate(), std::invalid_argument);
   p = {};
   for (int bad : {0, 10001}) {
@@ -209,6 +216,46 @@ TEST(BatchRefiner, EndsAtTheSameOptimumFromDifferentOnlineWindows) {
   ASSERT_EQ(stats[0].observation_factors, stats[1].observation_factors);
   EXPECT_NE(stats[0].initial_cost, stats[1].initial_cost);  // the online estimates differ
   EXPECT_NEAR(stats[0].final_cost, stats[1].final_cost, 1e-5 * stats[0].final_cost);
+}
+
+// Observations noisier than their covariances say (as a segment's fit covariance is against a
+// depth camera's systematic error): weighted as stated they outweigh the odometry; with the
+// variance factor estimated from their residuals the batch weighs them by what they are.
+TEST(BatchRefiner, ObservationsNoisierThanStatedAreWeighedByTheirEstimatedVariance) {
+  const std::vector<test::TrueLandmark> world = test::corridorWorld(20);
+  const std::vector<Eigen::Isometry3d> poses = test::corridorTrajectory(700);
+  const double noise_scale = 4.0;  // the true variance is 16 x the stated one
+  QuadricMapper mapper;
+  const RecordedRun run = runAndRecord(&mapper, world, poses, 102, noise_scale);
+  const AbsoluteTrajectoryError ate;
+  std::vector<double> refined_ate;
+  for (int rounds : {0, 3}) {
+    BatchRefiner::Params params;
+    params.noise_rounds = rounds;
+    const BatchSolution solution = BatchRefiner(params).refine(run.recorder, mapper);
+    const BatchStatistics& s = solution.statistics;
+    ASSERT_TRUE(s.solution_usable) << s.report;
+    Trajectory refined;
+    for (const RefinedPose& p : solution.trajectory)
+      refined.push_back({p.stamp, p.T_map_camera});
+    refined_ate.push_back(ate.evaluate(run.truth, refined).rmse());
+    std::cout << "noise_rounds " << rounds << ": " << s.solves << " solves, residual median "
+              << s.observation_residual_median << " sigma, factor " << s.observation_variance_factor
+              << "; refined ATE " << refined_ate.back() << " m (online "
+              << ate.evaluate(run.truth, run.online).rmse() << " m)\n";
+    if (rounds == 0) {
+      EXPECT_EQ(s.observation_variance_factor, 1.0);
+      EXPECT_EQ(s.solves, 1);
+      EXPECT_GT(s.observation_residual_median, 4.0);  // sqrt(16 k): the covariances are wrong
+      continue;
+    }
+    // At the optimum the residuals are smaller than the noise (the fit takes up some of it).
+    EXPECT_GT(s.observation_variance_factor, 6.0);
+    EXPECT_LT(s.observation_variance_factor, 24.0);
+    EXPECT_GT(s.observation_residual_median, 1.0);
+    EXPECT_LT(s.observation_residual_median, 3.0);
+  }
+  EXPECT_LT(refined_ate[1], 0.9 * refined_ate[0]);
 }
 
 }  // namespace

@@ -138,6 +138,8 @@ TEST(PipelineParams, MappingYamlKeysAreAllRead) {
   EXPECT_EQ(batch.max_iterations, file["batch_max_iterations"].as<int>());
   EXPECT_EQ(batch.max_keyframes, file["batch_max_keyframes"].as<int>());
   EXPECT_EQ(batch.compute_covariance, file["batch_compute_covariance"].as<bool>());
+  EXPECT_EQ(batch.noise_rounds, file["batch_noise_rounds"].as<int>());
+  EXPECT_DOUBLE_EQ(batch.noise_tolerance, file["batch_noise_tolerance"].as<double>());
 }
 
 // The measurement model error (mapping/measurement_model_error.h): the file's values reach the
@@ -205,10 +207,18 @@ TEST(PipelineParams, BatchRefinementKeysAreValidated) {
       batch, log);
   EXPECT_TRUE(enabled);
   EXPECT_EQ(batch.max_iterations, 7);
+  qs::readBatchRefinementParams(
+      qs::YamlParamReader(YAML::Load("{batch_noise_rounds: 0, batch_noise_tolerance: 0.5}")),
+      enabled, batch, log);
+  EXPECT_EQ(batch.noise_rounds, 0);
+  EXPECT_EQ(batch.noise_tolerance, 0.5);
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"{batch_max_iterations: 0}", "max_iterations"},
            {"{batch_max_iterations: 10001}", "max_iterations"},
-           {"{batch_max_keyframes: 0}", "max_keyframes"}}) {
+           {"{batch_max_keyframes: 0}", "max_keyframes"},
+           {"{batch_noise_rounds: 11}", "noise_rounds"},
+           {"{batch_noise_tolerance: 0}", "noise_tolerance"},
+           {"{batch_noise_tolerance: 11}", "noise_tolerance"}}) {
     qs::BatchRefiner::Params fresh;
     try {
       qs::readBatchRefinementParams(qs::YamlParamReader(YAML::Load(bad)), enabled, fresh, log);
