@@ -58,7 +58,8 @@ Eigen::MatrixXd LandmarkMerger::covarianceOf(const QuadricLandmark& landmark) co
 }
 
 LandmarkMerger::Comparison LandmarkMerger::compare(const QuadricLandmark& a,
-                                                   const QuadricLandmark& b) const {
+                                                   const QuadricLandmark& b,
+                                                   const Eigen::MatrixXd* cross_ab) const {
   Comparison out;
   if (!sameKind(a.quadric_map, b.quadric_map))
     return out;
@@ -67,13 +68,18 @@ LandmarkMerger::Comparison LandmarkMerger::compare(const QuadricLandmark& a,
                       box_b.transformed(a.quadric_map.pose().inverse() * b.quadric_map.pose())
                           .overlaps(box_a, params_.extent_margin);
 
-  // d^2 = x^T (C_a + C_b' + F)^-1 x with x = b' [-] a (surface_fusion.h).
+  // d^2 = x^T (C_a + C_b' - C_ab' - C_ab'^T + F)^-1 x with x = b' [-] a (surface_fusion.h).
   const AlignedSurface b_aligned = alignCovariance(b.quadric_map, covarianceOf(b), a.quadric_map);
   const Eigen::VectorXd x = b_aligned.quadric.minusMinimal(a.quadric_map);
   Eigen::MatrixXd S =
       covarianceOf(a) + b_aligned.matrix +
       diagonalMinimalCovariance(a.quadric_map, params_.floor_translation_sigma,
                                 params_.floor_rotation_sigma, params_.floor_scale_fraction);
+  if (cross_ab != nullptr && cross_ab->rows() == S.rows() && cross_ab->cols() == S.cols() &&
+      cross_ab->allFinite()) {
+    const Eigen::MatrixXd cross_aligned = *cross_ab * b_aligned.transform.transpose();
+    S -= cross_aligned + cross_aligned.transpose();
+  }
   S = 0.5 * (S + S.transpose()).eval();
   const Eigen::LLT<Eigen::MatrixXd> llt(S);
   if (llt.info() != Eigen::Success || !x.allFinite())
@@ -83,7 +89,7 @@ LandmarkMerger::Comparison LandmarkMerger::compare(const QuadricLandmark& a,
   return out;
 }
 
-std::vector<DuplicatePair> LandmarkMerger::findDuplicates(
+std::vector<std::pair<int, int>> LandmarkMerger::nearPairs(
     const std::map<int, QuadricLandmark>& landmarks, const std::set<int>* subset) const {
   // Landmarks with a known extent, with their boxes in the map frame (grown below).
   struct Entry {
@@ -98,21 +104,34 @@ std::vector<DuplicatePair> LandmarkMerger::findDuplicates(
       entries.push_back({&landmark, box.transformed(landmark.quadric_map.pose())});
   }
   auto inSubset = [&](int id) { return subset == nullptr || subset->count(id) > 0; };
-  std::vector<DuplicatePair> pairs;
+  std::vector<std::pair<int, int>> pairs;
   for (size_t i = 0; i < entries.size(); ++i) {
     const QuadricLandmark& a = *entries[i].landmark;
     const bool a_in = inSubset(a.id);
     for (size_t j = i + 1; j < entries.size(); ++j) {
       const QuadricLandmark& b = *entries[j].landmark;
-      if (!a_in && !inSubset(b.id))
-        continue;
-      if (!sameKind(a.quadric_map, b.quadric_map) ||
-          !entries[i].box_map.overlaps(entries[j].box_map, params_.extent_margin))
-        continue;
-      const Comparison c = compare(a, b);
-      if (c.sameSurface())
-        pairs.push_back({a.id, b.id, c.squared_distance});
+      if ((a_in || inSubset(b.id)) && sameKind(a.quadric_map, b.quadric_map) &&
+          entries[i].box_map.overlaps(entries[j].box_map, params_.extent_margin))
+        pairs.emplace_back(a.id, b.id);
     }
+  }
+  return pairs;
+}
+
+std::vector<DuplicatePair> LandmarkMerger::findDuplicates(
+    const std::map<int, QuadricLandmark>& landmarks, const std::set<int>* subset,
+    const CrossCovariances* cross) const {
+  std::vector<DuplicatePair> pairs;
+  for (const auto& [id_a, id_b] : nearPairs(landmarks, subset)) {
+    const Eigen::MatrixXd* cross_ab = nullptr;
+    if (cross != nullptr) {
+      const auto it = cross->find({id_a, id_b});
+      if (it != cross->end())
+        cross_ab = &it->second;
+    }
+    const Comparison c = compare(landmarks.at(id_a), landmarks.at(id_b), cross_ab);
+    if (c.sameSurface())
+      pairs.push_back({id_a, id_b, c.squared_distance});
   }
   std::sort(pairs.begin(), pairs.end(), [](const DuplicatePair& p, const DuplicatePair& q) {
     return p.squared_distance < q.squared_distance ||
@@ -124,6 +143,21 @@ std::vector<DuplicatePair> LandmarkMerger::findDuplicates(
 
 bool LandmarkMerger::survives(const QuadricLandmark& a, const QuadricLandmark& b) {
   return a.observations > b.observations || (a.observations == b.observations && a.id < b.id);
+}
+
+std::optional<QuadricLandmark> LandmarkMerger::mergePair(const QuadricLandmark& a, bool a_fixed,
+                                                         const QuadricLandmark& b, bool b_fixed,
+                                                         LandmarkMerge* merge,
+                                                         const Eigen::MatrixXd* cross_ab) const {
+  if ((a_fixed && b_fixed) || !compare(a, b, cross_ab).sameSurface())
+    return std::nullopt;
+  const bool a_survives = a_fixed || (!b_fixed && survives(a, b));
+  const QuadricLandmark& survivor = a_survives ? a : b;
+  const QuadricLandmark& merged = a_survives ? b : a;
+  QuadricLandmark out = fused(survivor, merged, a_fixed || b_fixed);
+  *merge = {merged.id, survivor.id,
+            Eigen::Isometry3d(out.quadric_map.pose().inverse() * merged.quadric_map.pose())};
+  return out;
 }
 
 QuadricLandmark LandmarkMerger::fused(const QuadricLandmark& survivor,

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 
 #include "quadric_slam/mapping/factors.h"
@@ -275,22 +276,15 @@ std::vector<LandmarkMerge> QuadricMapper::mergeLandmarks(const std::set<int>* su
     const auto a = map_.landmarks().find(pair.id_a), b = map_.landmarks().find(pair.id_b);
     if (a == map_.landmarks().end() || b == map_.landmarks().end())
       continue;  // one of them was merged earlier in this pass
-    // An earlier merge of this pass may have changed one of them: test again.
-    if (!merger.compare(a->second, b->second).sameSurface())
-      continue;
-    const bool a_fixed = window_.landmarkFixed(pair.id_a),
-               b_fixed = window_.landmarkFixed(pair.id_b);
-    if (a_fixed && b_fixed)
-      continue;  // a loaded, trusted map is not rewritten
-    const bool a_survives = a_fixed || (!b_fixed && LandmarkMerger::survives(a->second, b->second));
-    const QuadricLandmark survivor = a_survives ? a->second : b->second;
-    const QuadricLandmark merged = a_survives ? b->second : a->second;
-    const QuadricLandmark fused = merger.fused(survivor, merged, a_fixed || b_fixed);
-    merges.push_back(
-        {merged.id, survivor.id,
-         Eigen::Isometry3d(fused.quadric_map.pose().inverse() * merged.quadric_map.pose())});
-    window_.mergeLandmark(merged.id, survivor.id, fused.quadric_map);
-    map_.absorbLandmark(merged.id, fused);
+    LandmarkMerge merge;
+    const std::optional<QuadricLandmark> survivor =
+        merger.mergePair(a->second, window_.landmarkFixed(pair.id_a), b->second,
+                         window_.landmarkFixed(pair.id_b), &merge);
+    if (!survivor)
+      continue;  // changed by an earlier merge of this pass, or a loaded, trusted map
+    merges.push_back(merge);
+    window_.mergeLandmark(merge.merged_id, merge.survivor_id, survivor->quadric_map);
+    map_.absorbLandmark(merge.merged_id, *survivor);
   }
   return merges;
 }

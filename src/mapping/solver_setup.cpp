@@ -58,4 +58,37 @@ std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
   return out;
 }
 
+std::map<std::pair<int, int>, Eigen::MatrixXd> landmarkCrossCovariances(
+    ceres::Problem* problem, const std::map<int, LandmarkBlock>& landmarks,
+    const std::vector<std::pair<int, int>>& pairs) {
+  std::map<std::pair<int, int>, Eigen::MatrixXd> out;
+  std::vector<std::pair<const double*, const double*>> blocks;
+  std::vector<std::pair<int, int>> requested;
+  for (const auto& [id_a, id_b] : pairs) {
+    const auto a = landmarks.find(id_a), b = landmarks.find(id_b);
+    if (a == landmarks.end() || b == landmarks.end() || id_a == id_b)
+      continue;
+    blocks.emplace_back(a->second.parameters, b->second.parameters);
+    requested.emplace_back(id_a, id_b);
+  }
+  if (blocks.empty())
+    return out;
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  if (!covariance.Compute(blocks, problem))
+    return out;
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const LandmarkBlock& a = landmarks.at(requested[i].first);
+    const LandmarkBlock& b = landmarks.at(requested[i].second);
+    RowMajor c(a.minimal_size, b.minimal_size);
+    if (covariance.GetCovarianceBlockInTangentSpace(blocks[i].first, blocks[i].second, c.data()) &&
+        c.allFinite())
+      out[requested[i]] = c;
+  }
+  return out;
+}
+
 }  // namespace quadric_slam

@@ -32,8 +32,9 @@ AlignedSurface alignCovariance(const QuadricModel& b, const Eigen::MatrixXd& cov
   if (reference.quadricClass() != c)
     throw std::invalid_argument("alignCovariance: classes differ");
   requireSquare(covariance, minimalDimension(c), "covariance");
-  AlignedSurface out{alignToReference(b, reference), {}};
-  const Eigen::MatrixXd M = minimalAdjoint(c, symmetryElement(b, out.quadric).inverse());
+  AlignedSurface out{alignToReference(b, reference), {}, {}};
+  out.transform = minimalAdjoint(c, symmetryElement(b, out.quadric).inverse());
+  const Eigen::MatrixXd& M = out.transform;
   out.matrix = M * covariance * M.transpose();
   out.matrix = 0.5 * (out.matrix + out.matrix.transpose()).eval();
   return out;
@@ -45,8 +46,9 @@ AlignedSurface alignInformation(const QuadricModel& b, const Eigen::MatrixXd& in
   if (reference.quadricClass() != c)
     throw std::invalid_argument("alignInformation: classes differ");
   requireSquare(information, minimalDimension(c), "information");
-  AlignedSurface out{alignToReference(b, reference), {}};
-  const Eigen::MatrixXd N = minimalAdjoint(c, symmetryElement(b, out.quadric));
+  AlignedSurface out{alignToReference(b, reference), {}, {}};
+  out.transform = minimalAdjoint(c, symmetryElement(b, out.quadric));
+  const Eigen::MatrixXd& N = out.transform;
   out.matrix = N.transpose() * information * N;
   out.matrix = 0.5 * (out.matrix + out.matrix.transpose()).eval();
   return out;

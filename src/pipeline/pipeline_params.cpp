@@ -159,6 +159,7 @@ void readBatchRefinementParams(const ParamReader& reader, bool& enabled,
   readParam(reader, "batch_compute_covariance", params.compute_covariance, log);
   readParam(reader, "batch_noise_rounds", params.noise_rounds, log);
   readParam(reader, "batch_noise_tolerance", params.noise_tolerance, log);
+  readParam(reader, "batch_merge_rounds", params.merge_rounds, log);
   params.validate();
 }
 

@@ -241,10 +241,12 @@ void printTrajectoryErrors(const std::string& gt_path, const qs::Trajectory& est
 
 // The offline batch refinement (mapping/batch_refiner.h) of the run: writes the refined
 // trajectory to out_dir/trajectory.txt, prints its size, cost and time, and returns the refined
-// landmarks. After a reset of the input (time went backwards) only the last session was recorded:
-// then, or when the solve is not usable, trajectory.txt is the online one and the map stays online.
+// landmarks, and in `merges` the landmarks it merged. After a reset of the input (time went
+// backwards) only the last session was recorded: then, or when the solve is not usable,
+// trajectory.txt is the online one and the map stays online.
 std::vector<qs::QuadricLandmark> refineOffline(const qs::QuadricSlam& slam, std::size_t resets,
-                                               const std::string& out_dir) {
+                                               const std::string& out_dir,
+                                               std::vector<qs::LandmarkMerge>* merges) {
   const std::string online = out_dir + "/trajectory_online.txt";
   const std::string refined = out_dir + "/trajectory.txt";
   if (resets > 0) {
@@ -282,12 +284,13 @@ std::vector<qs::QuadricLandmark> refineOffline(const qs::QuadricSlam& slam, std:
   qs::writeTumTrajectory(trajectory, refined,
                          "quadric_slam run_bag: camera optical frame in the map frame, after the "
                          "batch refinement");
-  // Refined surfaces may come to agree: counted, not merged (merging needs the online state).
+  *merges = solution.merges;
+  std::printf("batch merged landmarks %d\n", s.merged_landmarks);
+  // Pairs the batch's merge passes left (none once the passes converge).
   std::map<int, qs::QuadricLandmark> refined_by_id;
   for (const qs::QuadricLandmark& landmark : solution.landmarks)
     refined_by_id[landmark.id] = landmark;
-  const std::vector<qs::DuplicatePair> pairs =
-      slam.mapper().map().merger().findDuplicates(refined_by_id);
+  const std::vector<qs::DuplicatePair>& pairs = solution.duplicates;
   std::map<std::string, int> pairs_per_class;
   for (const qs::DuplicatePair& pair : pairs)
     ++pairs_per_class[qs::toString(refined_by_id.at(pair.id_a).quadric_map.quadricClass())];
@@ -523,10 +526,11 @@ int main(int argc, char** argv) {
           "left %zu, merged at save %zu, duplicate pairs saved %zu\n",
           joined, merged_online, duplicates_online, merged_at_save, duplicates_saved);
       std::vector<qs::QuadricLandmark> landmarks = slam.mapper().landmarks();
+      std::vector<qs::LandmarkMerge> batch_merges;
       if (batch) {
         qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"),
                          o.out_dir + "/map_online.yaml");
-        landmarks = refineOffline(slam, resets, o.out_dir);
+        landmarks = refineOffline(slam, resets, o.out_dir, &batch_merges);
       }
       qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"), o.out_dir + "/map.yaml");
       std::map<std::string, int> per_class;
@@ -540,8 +544,10 @@ int main(int argc, char** argv) {
       std::map<int, qs::QuadricModel> surfaces;
       for (const qs::QuadricLandmark& landmark : landmarks)
         surfaces[landmark.id] = landmark.quadric_map;
-      pcl::fromROSMsg(qs::reconstructionCloudMsg(slam.reconstruction().cloud(surfaces), header),
-                      points);
+      // The points of landmarks the batch merged go to their survivors.
+      qs::QuadricReconstruction reconstruction = slam.reconstruction();
+      qs::applyMergesToReconstruction(batch_merges, &reconstruction);
+      pcl::fromROSMsg(qs::reconstructionCloudMsg(reconstruction.cloud(surfaces), header), points);
       if (!points.empty())
         pcl::io::savePCDFileBinary(o.out_dir + "/reconstruction.pcd", points);
       std::printf("map landmarks %zu:", landmarks.size());

@@ -12,6 +12,13 @@
 // whitened residuals (mapping/observation_noise_scale.h), at the online estimates and again at each
 // solution until it settles (at most noise_rounds solves): the segments' fit covariances describe
 // pixel noise, not the scatter of a surface's observations between views.
+// Under those honest covariances refined surfaces may turn out to be the same surface, with
+// parameters that agree within their covariances and extents that touch (mapping/landmark_merger.h,
+// the online map's merger and its tests): such landmarks are merged, the merged one's observations
+// moved onto the survivor, and the problem solved again, for at most merge_rounds passes. The
+// merges are reported (BatchSolution::merges) so that what is stored per landmark (reconstruction
+// points) can follow.
+// The problem itself is mapping/batch_problem.h.
 // No marginalisation prior and no landmark re-entry prior: every factor they summarised is in the
 // problem itself. Solved with the dog-leg trust region (ceres::DOGLEG, as the paper) for at most
 // max_iterations iterations, starting from the online estimates.
@@ -31,6 +38,7 @@
 
 #include "quadric_slam/mapping/batch_recorder.h"
 #include "quadric_slam/mapping/landmark.h"
+#include "quadric_slam/mapping/landmark_merger.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
 
 namespace quadric_slam {
@@ -56,6 +64,7 @@ struct BatchStatistics {
   // is off), and the solves it took.
   double observation_variance_factor = 1.0;
   int solves = 0;
+  int merged_landmarks = 0;  // merged into another landmark (BatchSolution::merges)
   double solve_seconds = 0.0, covariance_seconds = 0.0;  // wall time
 };
 
@@ -68,7 +77,12 @@ struct BatchSolution {
   BatchStatistics statistics;
   std::vector<Eigen::Isometry3d> keyframe_poses;  // per recorded keyframe, refined
   std::vector<RefinedPose> trajectory;            // per recorded frame, re-attached
-  std::vector<QuadricLandmark> landmarks;         // the whole map (id order), refined estimates
+  std::vector<QuadricLandmark> landmarks;  // the whole map (id order), refined estimates, merged
+                                           // landmarks removed
+  std::vector<LandmarkMerge> merges;       // the batch's merges, in their order
+  // Pairs of refined landmarks still the same surface after the merge passes (tested with their
+  // cross-covariances): none when the passes converged.
+  std::vector<DuplicatePair> duplicates;
 };
 
 class BatchRefiner {
@@ -91,6 +105,9 @@ class BatchRefiner {
     // in (0, 10].
     int noise_rounds = 3;
     double noise_tolerance = 0.1;
+    // Passes of merging duplicate landmarks after a solve (each landmark in at most one merge a
+    // pass), each followed by a solve; 0 = off. int in [0, 10].
+    int merge_rounds = 3;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;

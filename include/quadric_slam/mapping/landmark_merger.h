@@ -8,6 +8,10 @@
 //      in the class's minimal space (mapping/surface_fusion.h; b' = b re-expressed by the symmetry
 //      element closest to a),
 //        d^2 = x^T (C_a + C_b' + F)^-1 x <= chi2_k(gate_probability),
+//      (with their cross-covariance C_ab when the caller has it, the covariance of the difference
+//      C_a + C_b' - C_ab' - C_ab'^T: landmarks seen from the same views share those views' pose
+//      errors, which the marginals count twice; in a batch over a whole run, whose marginals hold
+//      the drift from its first frame, that is most of them),
 //      where C are the landmarks' marginal covariances (missing ones, e.g. of a candidate, a
 //      loaded landmark or a window whose marginals failed, are replaced by the `missing_*`
 //      covariance) and F is a model-error floor (the window's marginals only know the sensor noise
@@ -27,7 +31,9 @@
 #include <array>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "quadric_slam/geometry/quadric.h"
@@ -50,6 +56,10 @@ struct DuplicatePair {
   int id_a = 0, id_b = 0;
   double squared_distance = 0.0;
 };
+
+// Cross-covariances Cov(a, b) (rows: a's minimal tangent, columns: b's) of pairs of landmarks,
+// keyed by (id a, id b) with id a < id b.
+using CrossCovariances = std::map<std::pair<int, int>, Eigen::MatrixXd>;
 
 class LandmarkMerger {
  public:
@@ -91,14 +101,22 @@ class LandmarkMerger {
   // The covariance the tests use for `landmark`: its own when it is k x k, else the missing one.
   Eigen::MatrixXd covarianceOf(const QuadricLandmark& landmark) const;
 
-  // Tests 1-3 above (symmetric up to the linearisation).
-  Comparison compare(const QuadricLandmark& a, const QuadricLandmark& b) const;
+  // Tests 1-3 above (symmetric up to the linearisation); cross_ab = Cov(a, b) when known.
+  Comparison compare(const QuadricLandmark& a, const QuadricLandmark& b,
+                     const Eigen::MatrixXd* cross_ab = nullptr) const;
 
+  // The pairs (id a < id b) of the same kind whose extent boxes, in the map frame and grown by
+  // extent_margin, overlap, with at least one member in `subset` (every landmark when null): the
+  // only pairs that can be the same surface.
+  std::vector<std::pair<int, int>> nearPairs(const std::map<int, QuadricLandmark>& landmarks,
+                                             const std::set<int>* subset = nullptr) const;
   // Every pair of landmarks that are the same surface and have at least one member in `subset`
-  // (every landmark when subset is null), by increasing d^2. A cheap map-frame box test comes
-  // first, so the cost is one box test per pair and one chi-square test per near pair.
+  // (every landmark when subset is null), by increasing d^2; with `cross`, the pairs it holds are
+  // tested with their cross-covariance. The cheap box test of nearPairs() comes first, so the cost
+  // is one box test per pair and one chi-square test per near pair.
   std::vector<DuplicatePair> findDuplicates(const std::map<int, QuadricLandmark>& landmarks,
-                                            const std::set<int>* subset = nullptr) const;
+                                            const std::set<int>* subset = nullptr,
+                                            const CrossCovariances* cross = nullptr) const;
 
   // The survivor after absorbing `merged`: its id; the fusion of both estimates (quadric and k x k
   // covariance in its minimal tangent; with keep_estimate, a fixed survivor's own); the union of
@@ -108,6 +126,14 @@ class LandmarkMerger {
                         bool keep_estimate = false) const;
   // The survivor rule above without fixed landmarks: true when `a` survives a merge with `b`.
   static bool survives(const QuadricLandmark& a, const QuadricLandmark& b);
+  // One merge of a and b (a_fixed, b_fixed: held fixed, a loaded, trusted map) when they are the
+  // same surface, tested again (an earlier merge may have changed one) and not both fixed: the
+  // survivor by the rule above, after absorbing the other (fused(); a fixed survivor keeps its
+  // estimate), with `merge` filled in. nullopt when they are not merged.
+  std::optional<QuadricLandmark> mergePair(const QuadricLandmark& a, bool a_fixed,
+                                           const QuadricLandmark& b, bool b_fixed,
+                                           LandmarkMerge* merge,
+                                           const Eigen::MatrixXd* cross_ab = nullptr) const;
 
   const Params& params() const { return params_; }
 

@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 #include <map>
+#include <utility>
+#include <vector>
 
 namespace quadric_slam {
 
@@ -29,5 +31,12 @@ Eigen::MatrixXd acceptedCovariance(const Eigen::MatrixXd& covariance);
 // and all are when the problem is rank-deficient.
 std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
                                                    const std::map<int, LandmarkBlock>& landmarks);
+
+// Cross-covariances Cov(a, b) (rows: a's minimal tangent, columns: b's) of the requested pairs of
+// `landmarks` (ids), by ceres::Covariance (SPARSE_QR), keyed by the pair as given; a pair Ceres
+// cannot give is left out, and all are when the problem is rank-deficient.
+std::map<std::pair<int, int>, Eigen::MatrixXd> landmarkCrossCovariances(
+    ceres::Problem* problem, const std::map<int, LandmarkBlock>& landmarks,
+    const std::vector<std::pair<int, int>>& pairs);
 
 }  // namespace quadric_slam

@@ -29,9 +29,12 @@ struct SurfaceInformation {
 // `b` (covariance or information in its own minimal tangent) re-expressed by the member of its
 // symmetry orbit closest to `reference`. The returned matrix is in the tangent of the returned
 // quadric. Throws std::invalid_argument when the classes differ or the matrix is not k x k.
+// `transform` maps b's minimal tangent to the returned one (M above; for alignInformation, N): a
+// cross-covariance Cov(z, b) of b with another estimate z becomes Cov(z, b) M^T.
 struct AlignedSurface {
   QuadricModel quadric;
   Eigen::MatrixXd matrix;
+  Eigen::MatrixXd transform;
 };
 AlignedSurface alignCovariance(const QuadricModel& b, const Eigen::MatrixXd& covariance,
                                const QuadricModel& reference);

@@ -49,7 +49,8 @@ void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Par
 
 // config/mapping.yaml, the offline batch refinement at the end of run_bag (never read by the
 // nodelets): batch_refinement (on/off), batch_max_iterations, batch_max_keyframes,
-// batch_compute_covariance, batch_noise_rounds, batch_noise_tolerance.
+// batch_compute_covariance, batch_noise_rounds, batch_noise_tolerance,
+// batch_merge_rounds.
 void readBatchRefinementParams(const ParamReader& reader, bool& enabled,
                                BatchRefiner::Params& params, ParamLog& log);
 

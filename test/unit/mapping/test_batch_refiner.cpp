@@ -7,7 +7,9 @@
 // The solve finds the optimum of the whole problem whatever online path led to its start.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
+#include <map>
 #include <random>
 
 #include "map_report_checks.h"
@@ -65,6 +67,9 @@ TEST(BatchRefiner, ParamsValidate) {
   EXPECT_THROW(p.validate(), std::invalid_argument);
   p = {};
   p.noise_tolerance = 0.0;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = {};
+  p.merge_rounds = 11;
   EXPECT_THROW(p.validate(), std::invalid_argument);
   p = {};
   for (int bad : {0, 10001}) {
@@ -256,6 +261,127 @@ TEST(BatchRefiner, ObservationsNoisierThanStatedAreWeighedByTheirEstimatedVarian
     EXPECT_LT(s.observation_residual_median, 3.0);
   }
   EXPECT_LT(refined_ate[1], 0.9 * refined_ate[0]);
+}
+
+// The batch's merge passes (mapping/landmark_merger.h, tested with the refined covariances and
+// their cross-covariances). The run is mapped with merging off, so that what is one surface in
+// the world stays two landmarks online; the batch is then given the same landmarks in a mapper
+// whose merging is on (the default).
+struct UnmergedRun {
+  RecordedRun run;
+  std::vector<QuadricLandmark> online;
+};
+
+UnmergedRun runWithoutMerging(const std::vector<test::TrueLandmark>& world,
+                              const std::vector<Eigen::Isometry3d>& poses, int seed) {
+  QuadricMapper::Params params;
+  params.map.merging.enabled = false;
+  QuadricMapper unmerged(params);
+  UnmergedRun out{runAndRecord(&unmerged, world, poses, seed), unmerged.landmarks()};
+  return out;
+}
+
+BatchSolution refineWithMerging(const UnmergedRun& unmerged, int merge_rounds) {
+  QuadricMapper merging;
+  merging.loadLandmarks(unmerged.online, false);
+  BatchRefiner::Params params;
+  params.merge_rounds = merge_rounds;
+  return BatchRefiner(params).refine(unmerged.run.recorder, merging);
+}
+
+int landmarksOfClass(const std::vector<QuadricLandmark>& landmarks, QuadricClass c) {
+  return static_cast<int>(std::count_if(landmarks.begin(), landmarks.end(), [&](const auto& l) {
+    return l.quadric_map.quadricClass() == c;
+  }));
+}
+
+// A plane of the corridor's wall between world x = from and x = to.
+test::TrueLandmark wallFragment(double from, double to) {
+  return test::plane(Eigen::Vector3d(0.5 * (from + to), 2, 1.5), -Eigen::Vector3d::UnitY(),
+                     Eigen::Vector3d::UnitX(), 0.5 * (to - from), 1.5);
+}
+
+// The corridor's wall reported in two fragments meeting at x = 6 m, both in view from the first
+// frame: two wall landmarks online (merging off), one after the batch, whose covariance is no
+// larger than either fragment's; every other surface once.
+TEST(BatchRefiner, AWallSeenAsTwoFragmentsBecomesOneLandmark) {
+  std::vector<test::TrueLandmark> world = test::corridorWorld(12);
+  world[1] = wallFragment(-1.0, 6.0);
+  world.push_back(wallFragment(6.0, 17.0));
+  const std::vector<Eigen::Isometry3d> poses = test::corridorTrajectory(450);
+  const UnmergedRun unmerged = runWithoutMerging(world, poses, 103);
+  const int planes_online = landmarksOfClass(unmerged.online, QuadricClass::kPlane);
+  ASSERT_GE(planes_online, 3) << "the floor and both fragments of the wall";
+
+  const BatchSolution off = refineWithMerging(unmerged, 0);
+  const BatchSolution on = refineWithMerging(unmerged, 3);
+  ASSERT_TRUE(off.statistics.solution_usable && on.statistics.solution_usable);
+  std::cout << "planes online " << planes_online << ", after the batch without merging "
+            << landmarksOfClass(off.landmarks, QuadricClass::kPlane) << " (duplicate pairs "
+            << off.duplicates.size() << "), with merging "
+            << landmarksOfClass(on.landmarks, QuadricClass::kPlane) << " (" << on.merges.size()
+            << " merges, duplicate pairs left " << on.duplicates.size() << ")\n";
+  EXPECT_TRUE(off.merges.empty());
+  EXPECT_FALSE(off.duplicates.empty());
+  EXPECT_EQ(on.statistics.merged_landmarks, static_cast<int>(on.merges.size()));
+  EXPECT_EQ(on.landmarks.size() + on.merges.size(), unmerged.online.size());
+  EXPECT_TRUE(on.duplicates.empty());
+  EXPECT_EQ(landmarksOfClass(on.landmarks, QuadricClass::kPlane), 2) << "the floor and the wall";
+
+  // Against the truth with one wall: every surface once, none left over.
+  const std::vector<test::TrueLandmark> truth = test::corridorWorld(12);
+  const MapEvaluator evaluator;
+  const MapReport report =
+      evaluator.evaluate(test::truthMap(truth), test::estimateMap(on.landmarks), poses[0]);
+  std::cout << formatMapReport(report);
+  EXPECT_EQ(report.matched, static_cast<int>(truth.size()));
+  EXPECT_EQ(report.duplicates, 0);
+  EXPECT_EQ(report.unmatched_estimates, 0);
+
+  // The wall's survivor is better known than either fragment was in the same batch.
+  std::map<int, const QuadricLandmark*> parts;
+  for (const QuadricLandmark& l : off.landmarks)
+    parts[l.id] = &l;
+  for (const LandmarkMerge& merge : on.merges) {
+    const QuadricLandmark* survivor = nullptr;
+    for (const QuadricLandmark& l : on.landmarks)
+      if (l.id == merge.survivor_id)
+        survivor = &l;
+    ASSERT_NE(survivor, nullptr);
+    for (int part : {merge.merged_id, merge.survivor_id})
+      EXPECT_LE(survivor->covariance.trace(), parts.at(part)->covariance.trace()) << part;
+  }
+}
+
+// Two table tops at one height, 2 m apart along the corridor: one plane, two surfaces. Their
+// parameters agree, their extents do not touch: the batch keeps them two while merging is on.
+TEST(BatchRefiner, TwoTablesAtOneHeightStayTwo) {
+  std::vector<test::TrueLandmark> world = test::corridorWorld(12);
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ(), along = Eigen::Vector3d::UnitX();
+  world.push_back(test::plane(Eigen::Vector3d(4.0, 0.1, 0.7), up, along, 0.5, 0.3));
+  world.push_back(test::plane(Eigen::Vector3d(7.0, 0.1, 0.7), up, along, 0.5, 0.3));
+  const std::vector<Eigen::Isometry3d> poses = test::corridorTrajectory(450);
+  const UnmergedRun unmerged = runWithoutMerging(world, poses, 104);
+  const BatchSolution on = refineWithMerging(unmerged, 3);
+  ASSERT_TRUE(on.statistics.solution_usable);
+  EXPECT_TRUE(on.merges.empty());
+  EXPECT_TRUE(on.duplicates.empty());
+  // The table landmarks: horizontal planes 0.7 m above the floor.
+  std::vector<const QuadricLandmark*> tables;
+  for (const QuadricLandmark& l : on.landmarks) {
+    const Eigen::Isometry3d T_world_quadric = poses[0] * l.quadric_map.pose();
+    if (l.quadric_map.quadricClass() == QuadricClass::kPlane &&
+        std::abs(T_world_quadric.linear().col(0).z()) > 0.99 &&
+        std::abs(T_world_quadric.translation().z() - 0.7) < 0.05)
+      tables.push_back(&l);
+  }
+  ASSERT_EQ(tables.size(), 2u);
+  const LandmarkMerger merger;
+  const LandmarkMerger::Comparison c = merger.compare(*tables[0], *tables[1]);
+  std::cout << "tables: d^2 " << c.squared_distance << " (gate "
+            << merger.gate(QuadricClass::kPlane) << "), extents touch " << c.extents_touch << "\n";
+  EXPECT_TRUE(c.within_gate) << "one plane";
+  EXPECT_FALSE(c.extents_touch) << "two surfaces";
 }
 
 }  // namespace

@@ -46,6 +46,22 @@ double minEigenvalue(const Eigen::MatrixXd& m) {
       .minCoeff();
 }
 
+// A merger without the model-error floor: the statistic of the measured covariances alone.
+LandmarkMerger mergerWithoutFloor() {
+  LandmarkMerger::Params p;
+  p.floor_translation_sigma = p.floor_rotation_sigma = p.floor_scale_fraction = 0.0;
+  return LandmarkMerger(p);
+}
+
+// A sample of N(0, C).
+Eigen::VectorXd gaussianSample(const Eigen::MatrixXd& C, std::mt19937& rng) {
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  Eigen::VectorXd n(C.rows());
+  for (int i = 0; i < n.size(); ++i)
+    n[i] = gauss(rng);
+  return Eigen::MatrixXd(C.llt().matrixL()) * n;
+}
+
 TEST(LandmarkMerger, ParamsValidate) {
   LandmarkMerger::Params p;
   EXPECT_NO_THROW(p.validate());
@@ -66,11 +82,8 @@ TEST(LandmarkMerger, ParamsValidate) {
 // without a floor, d^2 follows chi2_k (mean k, 99.9% under the gate). A statistic in the wrong
 // tangent (a missing re-expression of the covariance, a wrong sign of the offset) fails this.
 TEST(LandmarkMerger, SquaredDistanceIsChiSquareForOneSurface) {
-  LandmarkMerger::Params p;
-  p.floor_translation_sigma = p.floor_rotation_sigma = p.floor_scale_fraction = 0.0;
-  const LandmarkMerger merger(p);
+  const LandmarkMerger merger = mergerWithoutFloor();
   std::mt19937 rng(7);
-  std::normal_distribution<double> gauss(0.0, 1.0);
   for (QuadricClass c : kAllQuadricClasses) {
     const int k = minimalDimension(c);
     const int trials = 2000;
@@ -85,10 +98,7 @@ TEST(LandmarkMerger, SquaredDistanceIsChiSquareForOneSurface) {
       };
       const Eigen::MatrixXd Ca = randomCovariance(), Cb = randomCovariance();
       auto sample = [&](const Eigen::MatrixXd& C) {
-        Eigen::VectorXd n(k);
-        for (int i = 0; i < k; ++i)
-          n[i] = gauss(rng);
-        return truth.plusMinimal(Eigen::MatrixXd(C.llt().matrixL()) * n);
+        return truth.plusMinimal(gaussianSample(C, rng));
       };
       QuadricLandmark a, b;
       a.id = 1;
@@ -185,6 +195,66 @@ TEST(LandmarkMerger, ParallelPlanesThreeCentimetresApartStayTwo) {
   QuadricLandmark unrefined = front;
   unrefined.covariance.resize(0, 0);
   EXPECT_TRUE(merger.compare(back, unrefined).within_gate);
+}
+
+// Two estimates of one surface that share an error (both seen from the same drifted views: a
+// batch's marginals relative to its first frame): with their cross-covariance the statistic is
+// chi2_k again, whatever frame the second is expressed in; from the marginals alone it is far
+// smaller (the shared error counted twice).
+TEST(LandmarkMerger, CorrelatedEstimatesAreComparedByTheCovarianceOfTheirDifference) {
+  const LandmarkMerger merger = mergerWithoutFloor();
+  std::mt19937 rng(11);
+  for (QuadricClass c : kAllQuadricClasses) {
+    const int k = minimalDimension(c);
+    auto sampleOf = [&](const Eigen::MatrixXd& C) { return gaussianSample(C, rng); };
+    const Eigen::MatrixXd shared = 0.03 * 0.03 * Eigen::MatrixXd::Identity(k, k);
+    const Eigen::MatrixXd own = 0.002 * 0.002 * Eigen::MatrixXd::Identity(k, k);
+    const int trials = 2000;
+    double with_cross = 0.0, marginals_only = 0.0;
+    for (int t = 0; t < trials; ++t) {
+      const QuadricModel truth = test::randomQuadric(c, rng);
+      const Eigen::VectorXd e = sampleOf(shared);
+      QuadricLandmark a, b;
+      a.id = 1;
+      a.quadric_map = truth.plusMinimal(e + sampleOf(own));
+      a.covariance = shared + own;
+      const QuadricModel b0 = truth.plusMinimal(e + sampleOf(own));
+      const Eigen::Isometry3d G = test::randomSymmetry(c, rng);
+      b.id = 2;
+      b.quadric_map = QuadricModel(c, b0.pose() * G, b0.scale(), b0.signature());
+      const Eigen::MatrixXd M = minimalAdjoint(c, G.inverse());
+      b.covariance = M * (shared + own) * M.transpose();
+      const Eigen::MatrixXd cross = shared * M.transpose();  // Cov(a, b) in b's own tangent
+      with_cross += merger.compare(a, b, &cross).squared_distance;
+      marginals_only += merger.compare(a, b).squared_distance;
+    }
+    EXPECT_NEAR(with_cross / trials, k, 0.1 * k) << toString(c);
+    EXPECT_LT(marginals_only / trials, 0.1 * k) << toString(c);
+  }
+}
+
+// Parallel planes 3 cm apart whose marginals are 5 cm (both placed by the same uncertain views):
+// the marginals alone cannot tell them apart, their cross-covariance can.
+TEST(LandmarkMerger, SharedUncertaintyDoesNotMergeParallelPlanes) {
+  const LandmarkMerger merger;
+  QuadricLandmark back = landmarkOf(1, test::plane(Eigen::Vector3d(3, 0, 1), -kX, kY, 1, 1));
+  QuadricLandmark front =
+      landmarkOf(2, test::plane(Eigen::Vector3d(2.97, 0.2, 1), -kX, kY, 0.4, 0.4));
+  // A shared offset error along the common normal (the frames have the same orientation, so it is
+  // the same minimal vector in both).
+  const Eigen::MatrixXd shared = diagonalMinimalCovariance(back.quadric_map, 0.05, 1e-6, 0.0);
+  back.covariance += shared;
+  front.covariance += shared;
+  const Eigen::MatrixXd cross = shared;
+  EXPECT_TRUE(merger.compare(back, front).sameSurface());
+  const LandmarkMerger::Comparison c = merger.compare(back, front, &cross);
+  EXPECT_TRUE(c.extents_touch);
+  EXPECT_FALSE(c.within_gate) << "d2 " << c.squared_distance;
+  LandmarkMerge merge;
+  EXPECT_FALSE(merger.mergePair(back, false, front, false, &merge, &cross).has_value());
+  EXPECT_TRUE(merger.mergePair(back, false, front, false, &merge).has_value());
+  EXPECT_EQ(merge.survivor_id, 1);  // equal observations: the smaller id
+  EXPECT_EQ(merge.merged_id, 2);
 }
 
 TEST(LandmarkMerger, OtherClassesAndKindsNeverMerge) {

@@ -4,6 +4,7 @@
 // to one landmark (some behind a Huber loss), odometry, a constant pose, a constant landmark, and a
 // prior tying two landmarks and a pose (as a marginalisation prior does). Also: the dense-size
 // limit and a rank-deficient problem make it decline (the caller falls back to ceres::Covariance).
+// And the cross-covariances of pairs of landmarks (mapping/solver_setup.h) against a dense one.
 #include <gtest/gtest.h>
 
 #include <ceres/ceres.h>
@@ -172,6 +173,39 @@ TEST(SchurCovariance, DeclinesAboveTheDenseSizeAndOnARankDeficientProblem) {
   EXPECT_TRUE(out.empty());
   // Nor does the entry point report a covariance for the unobservable landmark.
   EXPECT_EQ(landmarkCovariances(&deficient.problem, deficient.requested).count(2), 0u);
+}
+
+// Cross-covariances of pairs of landmarks (the batch's merge test) against ceres::Covariance with
+// a dense SVD on the same problem; a pair with a constant landmark or an unknown id is left out.
+TEST(LandmarkCrossCovariances, AgreeWithADenseCovarianceOfThePair) {
+  WindowLikeProblem w;
+  build(&w, false);
+  const std::vector<std::pair<int, int>> pairs = {{0, 1}, {1, 3}, {2, 5}, {6, 7}, {0, 42}};
+  const std::map<std::pair<int, int>, Eigen::MatrixXd> cross =
+      landmarkCrossCovariances(&w.problem, w.requested, pairs);
+  EXPECT_EQ(cross.size(), 3u) << "landmark 7 is constant, 42 does not exist";
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;
+  ceres::Covariance dense(options);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (int i = 0; i < 3; ++i)
+    blocks.emplace_back(w.requested.at(pairs[i].first).parameters,
+                        w.requested.at(pairs[i].second).parameters);
+  ASSERT_TRUE(dense.Compute(blocks, &w.problem));
+  for (int i = 0; i < 3; ++i) {
+    const LandmarkBlock& a = w.requested.at(pairs[i].first);
+    const LandmarkBlock& b = w.requested.at(pairs[i].second);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> expected(a.minimal_size,
+                                                                                    b.minimal_size);
+    ASSERT_TRUE(
+        dense.GetCovarianceBlockInTangentSpace(a.parameters, b.parameters, expected.data()));
+    const Eigen::MatrixXd& got = cross.at(pairs[i]);
+    ASSERT_EQ(got.rows(), a.minimal_size);
+    ASSERT_EQ(got.cols(), b.minimal_size);
+    EXPECT_GT(expected.norm(), 0.0);
+    EXPECT_LE((got - Eigen::MatrixXd(expected)).norm(), 1e-8 * expected.norm())
+        << pairs[i].first << "," << pairs[i].second;
+  }
 }
 
 }  // namespace

@@ -140,6 +140,7 @@ TEST(PipelineParams, MappingYamlKeysAreAllRead) {
   EXPECT_EQ(batch.compute_covariance, file["batch_compute_covariance"].as<bool>());
   EXPECT_EQ(batch.noise_rounds, file["batch_noise_rounds"].as<int>());
   EXPECT_DOUBLE_EQ(batch.noise_tolerance, file["batch_noise_tolerance"].as<double>());
+  EXPECT_EQ(batch.merge_rounds, file["batch_merge_rounds"].as<int>());
 }
 
 // The measurement model error (mapping/measurement_model_error.h): the file's values reach the
@@ -212,13 +213,18 @@ TEST(PipelineParams, BatchRefinementKeysAreValidated) {
       enabled, batch, log);
   EXPECT_EQ(batch.noise_rounds, 0);
   EXPECT_EQ(batch.noise_tolerance, 0.5);
+  qs::readBatchRefinementParams(qs::YamlParamReader(YAML::Load("{batch_merge_rounds: 0}")), enabled,
+                                batch, log);
+  EXPECT_EQ(batch.merge_rounds, 0);
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"{batch_max_iterations: 0}", "max_iterations"},
            {"{batch_max_iterations: 10001}", "max_iterations"},
            {"{batch_max_keyframes: 0}", "max_keyframes"},
            {"{batch_noise_rounds: 11}", "noise_rounds"},
            {"{batch_noise_tolerance: 0}", "noise_tolerance"},
-           {"{batch_noise_tolerance: 11}", "noise_tolerance"}}) {
+           {"{batch_noise_tolerance: 11}", "noise_tolerance"},
+           {"{batch_merge_rounds: -1}", "merge_rounds"},
+           {"{batch_merge_rounds: 11}", "merge_rounds"}}) {
     qs::BatchRefiner::Params fresh;
     try {
       qs::readBatchRefinementParams(qs::YamlParamReader(YAML::Load(bad)), enabled, fresh, log);
