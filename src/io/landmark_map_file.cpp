@@ -6,9 +6,10 @@
 namespace quadric_slam {
 
 MapFile mapFileFromLandmarks(const std::vector<QuadricLandmark>& landmarks,
-                             const std::string& frame_id) {
+                             const std::string& frame_id, const std::map<int, int>& merged_into) {
   MapFile map;
   map.frame_id = frame_id;
+  map.merged_into = merged_into;
   for (const QuadricLandmark& landmark : landmarks) {
     const QuadricModel& quadric = landmark.quadric_map;
     MapFileQuadric entry;

@@ -90,6 +90,12 @@ MapFile parseMapYaml(const std::string& text) {
     for (const auto& node : quadrics)
       map.quadrics.push_back(readQuadric(node));
   }
+  if (const YAML::Node merged = root["merged_into"]) {
+    if (!merged.IsMap())
+      throw std::runtime_error("'merged_into' must be a map of landmark ids");
+    for (const auto& entry : merged)
+      map.merged_into[entry.first.as<int>()] = entry.second.as<int>();
+  }
   return map;
 }
 
@@ -134,7 +140,14 @@ std::string mapYamlString(const MapFile& map) {
     }
     out << YAML::EndMap << YAML::EndMap;
   }
-  out << YAML::EndSeq << YAML::EndMap;
+  out << YAML::EndSeq;
+  if (!map.merged_into.empty()) {
+    out << YAML::Key << "merged_into" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    for (const auto& [id, into] : map.merged_into)
+      out << YAML::Key << id << YAML::Value << into;
+    out << YAML::EndMap;
+  }
+  out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
 

@@ -27,6 +27,13 @@ Eigen::MatrixXd inverseOf(const Eigen::MatrixXd& spd) {
 
 }  // namespace
 
+void recordMerge(int merged_id, int survivor_id, std::map<int, int>* merged_into) {
+  for (auto& [id, into] : *merged_into)
+    if (into == merged_id)
+      into = survivor_id;
+  (*merged_into)[merged_id] = survivor_id;
+}
+
 void LandmarkMerger::Params::validate() const {
   const ParamRangeCheck requireRange("LandmarkMerger::Params");
   requireRange(gate_probability > 0.0 && gate_probability < 1.0, "gate_probability", "(0, 1)");

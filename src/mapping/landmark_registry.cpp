@@ -315,10 +315,7 @@ void LandmarkRegistry::absorbLandmark(int merged_id, const QuadricLandmark& surv
   landmarks_.at(merged_id);  // both must exist (std::out_of_range) before anything changes
   landmarks_.at(survivor.id) = survivor;
   landmarks_.erase(merged_id);
-  for (auto& [id, into] : merged_into_)
-    if (into == merged_id)
-      into = survivor.id;
-  merged_into_[merged_id] = survivor.id;
+  recordMerge(merged_id, survivor.id, &merged_into_);
 }
 
 void LandmarkRegistry::insertLandmark(const QuadricLandmark& landmark) {

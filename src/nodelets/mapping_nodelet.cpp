@@ -693,7 +693,7 @@ class MappingNodelet : public nodelet::Nodelet {
       applyMergesToReconstruction(mapper_->mergeDuplicates(), reconstruction_.get());
       const std::vector<QuadricLandmark> landmarks = mapper_->landmarks();
       const sensor_msgs::PointCloud2Ptr cloud = reconstructionCloud(ros::Time::now());
-      saveMapFiles(path, landmarks, map_frame_, *cloud);
+      saveMapFiles(path, landmarks, map_frame_, *cloud, mapper_->map().mergedInto());
       // The latched outputs show what was saved (the map's counts move on between keyframes).
       publishMap(cloud->header.stamp);
       reconstruction_pub_.publish(cloud);

@@ -24,13 +24,14 @@ std::string reconstructionPathFor(const std::string& map_path) {
 }
 
 void saveMapFiles(const std::string& map_path, const std::vector<QuadricLandmark>& landmarks,
-                  const std::string& frame_id, const sensor_msgs::PointCloud2& reconstruction) {
+                  const std::string& frame_id, const sensor_msgs::PointCloud2& reconstruction,
+                  const std::map<int, int>& merged_into) {
   const fs::path parent = fs::path(map_path).parent_path();
   std::error_code error;
   if (!parent.empty() && !fs::exists(parent) && !fs::create_directories(parent, error))
     throw std::runtime_error("cannot create the directory " + parent.string() + ": " +
                              error.message());
-  writeMapYaml(mapFileFromLandmarks(landmarks, frame_id), map_path);
+  writeMapYaml(mapFileFromLandmarks(landmarks, frame_id, merged_into), map_path);
   const std::string pcd_path = reconstructionPathFor(map_path);
   if (reconstruction.width * reconstruction.height == 0) {
     fs::remove(pcd_path, error);  // no stale reconstruction beside the new map

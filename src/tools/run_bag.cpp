@@ -525,14 +525,19 @@ int main(int argc, char** argv) {
           "candidates joined at promotion %zu, landmarks merged online %zu, duplicate pairs "
           "left %zu, merged at save %zu, duplicate pairs saved %zu\n",
           joined, merged_online, duplicates_online, merged_at_save, duplicates_saved);
+      // Saved maps say which ids were merged into which (the online ones, then the batch's).
       std::vector<qs::QuadricLandmark> landmarks = slam.mapper().landmarks();
+      std::map<int, int> merged_into = slam.mapper().map().mergedInto();
       std::vector<qs::LandmarkMerge> batch_merges;
       if (batch) {
-        qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"),
+        qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map", merged_into),
                          o.out_dir + "/map_online.yaml");
         landmarks = refineOffline(slam, resets, o.out_dir, &batch_merges);
+        for (const qs::LandmarkMerge& merge : batch_merges)
+          qs::recordMerge(merge.merged_id, merge.survivor_id, &merged_into);
       }
-      qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map"), o.out_dir + "/map.yaml");
+      qs::writeMapYaml(qs::mapFileFromLandmarks(landmarks, "map", merged_into),
+                       o.out_dir + "/map.yaml");
       std::map<std::string, int> per_class;
       for (const qs::QuadricLandmark& landmark : landmarks)
         ++per_class[qs::toString(landmark.quadric_map.quadricClass())];

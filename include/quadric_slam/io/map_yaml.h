@@ -25,6 +25,10 @@ struct MapFileQuadric {
 struct MapFile {
   std::string frame_id = "map";
   std::vector<MapFileQuadric> quadrics;
+  // Landmarks merged into another because both were one surface: id merged away -> the id of this
+  // file's landmark that holds its surface (chains resolved), as QuadricMap.merged_ids /
+  // merged_into. Optional key `merged_into: {id: into, ...}`, written only when not empty.
+  std::map<int, int> merged_into;
 };
 
 // Throws std::runtime_error naming the file and the problem (missing key, wrong length, bad YAML).

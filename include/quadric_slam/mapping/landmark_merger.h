@@ -51,6 +51,10 @@ struct LandmarkMerge {
   Eigen::Isometry3d T_survivor_merged = Eigen::Isometry3d::Identity();
 };
 
+// Records in `merged_into` (id merged away -> the landmark holding its surface) that merged_id went
+// into survivor_id, resolving chains: ids that went into merged_id now go into survivor_id.
+void recordMerge(int merged_id, int survivor_id, std::map<int, int>* merged_into);
+
 // Two landmarks found to be the same surface, and their d^2.
 struct DuplicatePair {
   int id_a = 0, id_b = 0;

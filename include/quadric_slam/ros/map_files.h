@@ -11,6 +11,7 @@
 #include <pcl/point_types.h>
 #include <sensor_msgs/PointCloud2.h>
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -22,10 +23,12 @@ namespace quadric_slam {
 // map_path with its extension replaced by .pcd (appended when it has none).
 std::string reconstructionPathFor(const std::string& map_path);
 
-// Writes the map YAML and the reconstruction PCD (binary), creating the parent directory. An empty
-// reconstruction writes no PCD and removes a stale one. Throws std::runtime_error naming the file.
+// Writes the map YAML (with `merged_into`, merged landmark ids -> surviving ids) and the
+// reconstruction PCD (binary), creating the parent directory. An empty reconstruction writes no PCD
+// and removes a stale one. Throws std::runtime_error naming the file.
 void saveMapFiles(const std::string& map_path, const std::vector<QuadricLandmark>& landmarks,
-                  const std::string& frame_id, const sensor_msgs::PointCloud2& reconstruction);
+                  const std::string& frame_id, const sensor_msgs::PointCloud2& reconstruction,
+                  const std::map<int, int>& merged_into = {});
 
 struct LoadedMap {
   std::string frame_id;

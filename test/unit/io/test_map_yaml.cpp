@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 #include "quadric_slam/io/map_yaml.h"
@@ -22,6 +23,7 @@ TEST(MapYaml, RoundTripKeepsEveryField) {
   sphere.shape["center"] = {0.2, 0.9, 0.55};
   sphere.shape["radius"] = {0.16};
   map.quadrics.push_back(sphere);
+  map.merged_into = {{5, 3}, {9, 3}};
 
   const MapFile back = quadric_slam::parseMapYaml(quadric_slam::mapYamlString(map));
   EXPECT_EQ(back.frame_id, "world");
@@ -34,6 +36,7 @@ TEST(MapYaml, RoundTripKeepsEveryField) {
   EXPECT_TRUE(q.scale.isApprox(sphere.scale, 1e-8));
   EXPECT_EQ(q.shape.at("center").size(), 3u);
   EXPECT_NEAR(q.shape.at("radius").at(0), 0.16, 1e-12);
+  EXPECT_EQ(back.merged_into, map.merged_into);
 }
 
 TEST(MapYaml, ParsesTheDocumentedSchema) {
@@ -49,6 +52,9 @@ quadrics:
 )");
   ASSERT_EQ(map.quadrics.size(), 1u);
   EXPECT_EQ(map.quadrics[0].shape.at("normal"), (std::vector<double>{1, 0, 0}));
+  EXPECT_TRUE(map.merged_into.empty()) << "optional";
+  EXPECT_EQ(quadric_slam::parseMapYaml("quadrics: []\nmerged_into: {7: 1, 8: 1}\n").merged_into,
+            (std::map<int, int>{{7, 1}, {8, 1}}));
 }
 
 TEST(MapYaml, BadInputNamesTheProblem) {
@@ -63,4 +69,8 @@ TEST(MapYaml, BadInputNamesTheProblem) {
                                  "orientation: [0, 0, 0, 2]}, scale: [1, 1, 1]}\n"),
       std::runtime_error);
   EXPECT_THROW(quadric_slam::readMapYaml("/nonexistent/map.yaml"), std::runtime_error);
+  EXPECT_THROW(quadric_slam::parseMapYaml("quadrics: []\nmerged_into: [7, 1]\n"),
+               std::runtime_error);
+  EXPECT_THROW(quadric_slam::parseMapYaml("quadrics: []\nmerged_into: {a: 1}\n"),
+               std::runtime_error);
 }
