@@ -8,6 +8,47 @@
 
 namespace quadric_slam {
 
+namespace {
+
+// Covariance blocks Cov(a, b) in the minimal tangents of the requested pairs of `landmarks` (ids)
+// by ceres::Covariance (sparse QR of the whole problem), keyed by the pair; pairs with an unknown
+// id, or whose block Ceres cannot give or gives non-finite, are left out, and all are when the
+// problem is rank-deficient.
+std::map<std::pair<int, int>, Eigen::MatrixXd> ceresCovarianceBlocks(
+    ceres::Problem* problem, const std::map<int, LandmarkBlock>& landmarks,
+    const std::vector<std::pair<int, int>>& pairs) {
+  std::map<std::pair<int, int>, Eigen::MatrixXd> out;
+  std::vector<std::pair<const double*, const double*>> blocks;
+  std::vector<std::pair<int, int>> requested;
+  for (const auto& [id_a, id_b] : pairs) {
+    const auto a = landmarks.find(id_a), b = landmarks.find(id_b);
+    if (a == landmarks.end() || b == landmarks.end())
+      continue;
+    blocks.emplace_back(a->second.parameters, b->second.parameters);
+    requested.emplace_back(id_a, id_b);
+  }
+  if (blocks.empty())
+    return out;
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  if (!covariance.Compute(blocks, problem))
+    return out;
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  for (std::size_t i = 0; i < blocks.size(); ++i) {
+    const LandmarkBlock& a = landmarks.at(requested[i].first);
+    const LandmarkBlock& b = landmarks.at(requested[i].second);
+    RowMajor c(a.minimal_size, b.minimal_size);
+    if (covariance.GetCovarianceBlockInTangentSpace(blocks[i].first, blocks[i].second, c.data()) &&
+        c.allFinite())
+      out[requested[i]] = c;
+  }
+  return out;
+}
+
+}  // namespace
+
 ceres::Solver::Options landmarkSolverOptions(int max_iterations) {
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_SCHUR;
@@ -37,23 +78,13 @@ std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
   if (schurLandmarkCovariances(problem, landmarks, kMaxSchurDenseSize, &out))
     return out;
   out.clear();
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::SPARSE_QR;
-  options.num_threads = 1;
-  ceres::Covariance covariance(options);
-  std::vector<std::pair<const double*, const double*>> pairs;
+  std::vector<std::pair<int, int>> diagonal;
   for (const auto& [id, block] : landmarks)
-    pairs.emplace_back(block.parameters, block.parameters);
-  if (pairs.empty() || !covariance.Compute(pairs, problem))
-    return out;
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  for (const auto& [id, block] : landmarks) {
-    RowMajor c(block.minimal_size, block.minimal_size);
-    if (!covariance.GetCovarianceBlockInTangentSpace(block.parameters, block.parameters, c.data()))
-      continue;
+    diagonal.emplace_back(id, id);
+  for (const auto& [pair, c] : ceresCovarianceBlocks(problem, landmarks, diagonal)) {
     const Eigen::MatrixXd accepted = acceptedCovariance(c);
     if (accepted.size() > 0)
-      out[id] = accepted;
+      out[pair.first] = accepted;
   }
   return out;
 }
@@ -61,34 +92,11 @@ std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
 std::map<std::pair<int, int>, Eigen::MatrixXd> landmarkCrossCovariances(
     ceres::Problem* problem, const std::map<int, LandmarkBlock>& landmarks,
     const std::vector<std::pair<int, int>>& pairs) {
-  std::map<std::pair<int, int>, Eigen::MatrixXd> out;
-  std::vector<std::pair<const double*, const double*>> blocks;
-  std::vector<std::pair<int, int>> requested;
-  for (const auto& [id_a, id_b] : pairs) {
-    const auto a = landmarks.find(id_a), b = landmarks.find(id_b);
-    if (a == landmarks.end() || b == landmarks.end() || id_a == id_b)
-      continue;
-    blocks.emplace_back(a->second.parameters, b->second.parameters);
-    requested.emplace_back(id_a, id_b);
-  }
-  if (blocks.empty())
-    return out;
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::SPARSE_QR;
-  options.num_threads = 1;
-  ceres::Covariance covariance(options);
-  if (!covariance.Compute(blocks, problem))
-    return out;
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  for (std::size_t i = 0; i < blocks.size(); ++i) {
-    const LandmarkBlock& a = landmarks.at(requested[i].first);
-    const LandmarkBlock& b = landmarks.at(requested[i].second);
-    RowMajor c(a.minimal_size, b.minimal_size);
-    if (covariance.GetCovarianceBlockInTangentSpace(blocks[i].first, blocks[i].second, c.data()) &&
-        c.allFinite())
-      out[requested[i]] = c;
-  }
-  return out;
+  std::vector<std::pair<int, int>> distinct;
+  for (const auto& pair : pairs)
+    if (pair.first != pair.second)
+      distinct.push_back(pair);
+  return ceresCovarianceBlocks(problem, landmarks, distinct);
 }
 
 }  // namespace quadric_slam
