@@ -69,16 +69,17 @@ BatchProblem::BatchProblem(const BatchRecorder& recorder, const QuadricMapper& m
       auto it = landmarks_.find(id);
       if (it == landmarks_.end()) {
         const QuadricModel& online = map.landmark(id).quadric_map;
-        it = landmarks_.emplace(id, QuadricBlock{}).first;
-        quadricToParameters(online, it->second.data());
+        it = landmarks_.emplace(id, LandmarkEntry{}).first;
+        LandmarkEntry& entry = it->second;
+        quadricToParameters(online, entry.block.data());
         auto& manifold = quadric_manifolds_[online.quadricClass()];
         if (!manifold)
           manifold = std::make_unique<QuadricManifold>(online.quadricClass());
-        problem_.AddParameterBlock(it->second.data(), kQuadricParameterSize, manifold.get());
-        minimal_sizes_[id] = minimalDimension(online.quadricClass());
-        fixed_[id] = window.individuallyFixedLandmarks().count(id) > 0;
-        if (fixed_[id]) {
-          problem_.SetParameterBlockConstant(it->second.data());
+        problem_.AddParameterBlock(entry.block.data(), kQuadricParameterSize, manifold.get());
+        entry.minimal_size = minimalDimension(online.quadricClass());
+        entry.fixed = window.individuallyFixedLandmarks().count(id) > 0;
+        if (entry.fixed) {
+          problem_.SetParameterBlockConstant(entry.block.data());
           ++stats->fixed_landmarks;
         }
       }
@@ -96,7 +97,7 @@ void BatchProblem::addTermBlock(Term* term) {
   term->block = problem_.AddResidualBlock(
       QuadricObservationCost::Create(term->measurement->quadric_camera,
                                      term->measurement->covariance * factor_),
-      huber_.get(), term->pose, landmarks_.at(term->landmark_id).data());
+      huber_.get(), term->pose, landmarks_.at(term->landmark_id).block.data());
 }
 
 void BatchProblem::setFactor(double factor) {
@@ -152,23 +153,24 @@ Eigen::Isometry3d BatchProblem::keyframePose(std::size_t i) const {
 }
 
 bool BatchProblem::landmarkFixed(int id) const {
-  const auto it = fixed_.find(id);
-  return it != fixed_.end() && it->second;
+  const auto it = landmarks_.find(id);
+  return it != landmarks_.end() && it->second.fixed;
 }
 
 QuadricModel BatchProblem::landmarkEstimate(int id, const QuadricModel& like) const {
-  return quadricFromParameters(landmarks_.at(id).data(), like.quadricClass(), like.signature());
+  return quadricFromParameters(landmarks_.at(id).block.data(), like.quadricClass(),
+                               like.signature());
 }
 
 void BatchProblem::setLandmarkEstimate(int id, const QuadricModel& estimate) {
-  quadricToParameters(estimate, landmarks_.at(id).data());
+  quadricToParameters(estimate, landmarks_.at(id).block.data());
 }
 
 std::map<int, LandmarkBlock> BatchProblem::freeLandmarkBlocks() const {
   std::map<int, LandmarkBlock> free_blocks;
-  for (const auto& [id, block] : landmarks_)
-    if (!landmarkFixed(id))
-      free_blocks[id] = {block.data(), minimal_sizes_.at(id)};
+  for (const auto& [id, entry] : landmarks_)
+    if (!entry.fixed)
+      free_blocks[id] = {entry.block.data(), entry.minimal_size};
   return free_blocks;
 }
 
@@ -183,7 +185,7 @@ std::map<std::pair<int, int>, Eigen::MatrixXd> BatchProblem::landmarkCrossCovari
 
 void BatchProblem::mergeLandmark(int merged, int survivor) {
   if (merged == survivor || !hasLandmark(merged) || !hasLandmark(survivor) ||
-      minimal_sizes_.at(merged) != minimal_sizes_.at(survivor))
+      landmarks_.at(merged).minimal_size != landmarks_.at(survivor).minimal_size)
     throw std::invalid_argument("BatchProblem::mergeLandmark: landmark " + std::to_string(merged) +
                                 " cannot be merged into " + std::to_string(survivor));
   for (Term& term : terms_) {
@@ -192,10 +194,8 @@ void BatchProblem::mergeLandmark(int merged, int survivor) {
     term.landmark_id = survivor;
     addTermBlock(&term);
   }
-  problem_.RemoveParameterBlock(landmarks_.at(merged).data());
+  problem_.RemoveParameterBlock(landmarks_.at(merged).block.data());
   landmarks_.erase(merged);
-  minimal_sizes_.erase(merged);
-  fixed_.erase(merged);
 }
 
 std::vector<double> BatchProblem::residualNorms() const {

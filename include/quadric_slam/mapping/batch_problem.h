@@ -88,10 +88,14 @@ class BatchProblem {
   std::map<QuadricClass, std::unique_ptr<QuadricManifold>> quadric_manifolds_;
   std::unique_ptr<ceres::LossFunction> huber_;
   ceres::Problem problem_;
+  // A landmark's parameter block and what the covariances and merges need of it.
+  struct LandmarkEntry {
+    QuadricBlock block{};
+    int minimal_size = 0;
+    bool fixed = false;
+  };
   std::vector<PoseBlock> poses_;
-  std::map<int, QuadricBlock> landmarks_;  // node-based: block addresses stay put
-  std::map<int, int> minimal_sizes_;
-  std::map<int, bool> fixed_;
+  std::map<int, LandmarkEntry> landmarks_;  // node-based: block addresses stay put
   std::vector<Term> terms_;
   double factor_ = 1.0;
 };
