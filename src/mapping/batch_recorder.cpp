@@ -14,6 +14,7 @@ void BatchRecorder::record(const MapperFrameResult& result, const QuadricMapper&
   frame.stamp = result.stamp;
   frame.T_map_camera = result.T_map_camera;
   frame.T_odom_camera = result.T_map_odom.inverse() * result.T_map_camera;
+  frame.increment_covariance = result.increment_covariance;
   frame.keyframe = static_cast<int>(keyframes_.size()) - 1;
   frame.is_keyframe = result.keyframe;
   frames_.push_back(frame);

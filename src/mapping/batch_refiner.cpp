@@ -110,25 +110,6 @@ BatchRefiner::BatchRefiner(const Params& params) : params_(params) {
   params_.validate();
 }
 
-std::vector<RefinedPose> reattachFrames(const BatchRecorder& recorder,
-                                        const std::vector<Eigen::Isometry3d>& keyframe_poses) {
-  if (keyframe_poses.size() != recorder.keyframes().size())
-    throw std::invalid_argument("reattachFrames: one pose per recorded keyframe is needed");
-  std::vector<RefinedPose> out;
-  out.reserve(recorder.frames().size());
-  for (const RecordedFrame& frame : recorder.frames()) {
-    RefinedPose pose{frame.stamp, frame.T_map_camera};
-    if (frame.keyframe >= 0) {
-      const RecordedKeyframe& keyframe = recorder.keyframes()[frame.keyframe];
-      // The mapper's prediction (quadric_mapper.h, step 1) from the refined keyframe pose.
-      pose.T_map_camera =
-          keyframe_poses[frame.keyframe] * keyframe.T_odom_camera.inverse() * frame.T_odom_camera;
-    }
-    out.push_back(pose);
-  }
-  return out;
-}
-
 BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
                                    const QuadricMapper& mapper) const {
   const auto start = std::chrono::steady_clock::now();

@@ -148,6 +148,7 @@ MapperFrameResult QuadricMapper::process(const FrameMeasurements& frame,
   has_frame_ = true;
   last_stamp_ = frame.stamp;
   T_odom_previous_ = T_odom_camera;
+  result.increment_covariance = increment_covariance;
   const Matrix6d Ad = adjointSE3(T_previous_this.inverse());
   covariance_since_keyframe_ =
       Ad * covariance_since_keyframe_ * Ad.transpose() + increment_covariance;

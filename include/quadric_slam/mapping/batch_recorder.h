@@ -37,6 +37,9 @@ struct RecordedFrame {
   double stamp = 0.0;                                               // s
   Eigen::Isometry3d T_odom_camera = Eigen::Isometry3d::Identity();  // odometry
   Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();   // online estimate
+  // Covariance of the odometry increment from the previous recorded frame (body tangent of this
+  // frame, [rho; phi]; MapperFrameResult::increment_covariance).
+  Matrix6d increment_covariance = Matrix6d::Zero();
   int keyframe = -1;  // index into BatchRecorder::keyframes(); -1 before the first keyframe
   bool is_keyframe = false;
 };

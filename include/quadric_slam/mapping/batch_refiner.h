@@ -22,9 +22,9 @@
 // No marginalisation prior and no landmark re-entry prior: every factor they summarised is in the
 // problem itself. Solved with the dog-leg trust region (ceres::DOGLEG, as the paper) for at most
 // max_iterations iterations, starting from the online estimates.
-// Then every mapped frame is re-attached to its keyframe through its odometry (the mapper's
-// prediction, with the refined keyframe pose):
-//   T_map_frame = T_map_keyframe_refined T_odom_keyframe^-1 T_odom_frame.
+// Then the mapped frames are re-attached to the refined keyframes through their odometry, the
+// keyframes' disagreement with it spread over the steps between them by the steps' covariances
+// (mapping/frame_reattachment.h).
 // When the solve is not usable the online estimates are returned (solution_usable = false); a
 // landmark whose refined estimate is invalid (a scale pushed through zero) keeps its online one.
 // Cost: one sparse Schur solve over the whole run per iteration; memory and time grow with the
@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "quadric_slam/mapping/batch_recorder.h"
+#include "quadric_slam/mapping/frame_reattachment.h"
 #include "quadric_slam/mapping/landmark.h"
 #include "quadric_slam/mapping/landmark_merger.h"
 #include "quadric_slam/mapping/quadric_mapper.h"
@@ -66,11 +67,6 @@ struct BatchStatistics {
   int solves = 0;
   int merged_landmarks = 0;  // merged into another landmark (BatchSolution::merges)
   double solve_seconds = 0.0, covariance_seconds = 0.0;  // wall time
-};
-
-struct RefinedPose {
-  double stamp = 0.0;  // s
-  Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
 };
 
 struct BatchSolution {
@@ -125,11 +121,5 @@ class BatchRefiner {
  private:
   Params params_;
 };
-
-// T_map_frame = T_map_keyframe T_odom_keyframe^-1 T_odom_frame for every recorded frame, with
-// keyframe_poses[i] the pose of recorder.keyframes()[i] (frames before the first keyframe keep
-// their online estimate).
-std::vector<RefinedPose> reattachFrames(const BatchRecorder& recorder,
-                                        const std::vector<Eigen::Isometry3d>& keyframe_poses);
 
 }  // namespace quadric_slam

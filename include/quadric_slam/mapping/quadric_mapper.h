@@ -72,6 +72,10 @@ struct MapperFrameResult {
   double stamp = 0.0;
   Eigen::Isometry3d T_map_camera = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_map_odom = Eigen::Isometry3d::Identity();
+  // Covariance of the odometry increment from the previous accepted frame as the mapper used it
+  // (the input's, bounded by the camera's speed, or the Params noise model), this frame's body
+  // tangent [rho; phi]; zero for a refused frame.
+  Matrix6d increment_covariance = Matrix6d::Zero();
   bool keyframe = false;
   int rejected_measurements = 0;
   // Per accepted measurement, in input order with the rejected ones left out.

@@ -144,10 +144,10 @@ class QuadricSlam {
   // moves their reconstruction points to the survivors; call it before saving the map.
   std::vector<LandmarkMerge> mergeDuplicateLandmarks();
   // With params().batch_refinement: one global solve over every keyframe and landmark since the
-  // last reset (mapping/batch_refiner.h), the mapped frames re-attached to their keyframes. Leaves
-  // the online state as it is. A run of more than batch.max_keyframes keyframes is neither
-  // recorded nor solved (the solution is then empty and not usable, its report says why).
-  // Throws std::logic_error when batch_refinement is off.
+  // last reset (mapping/batch_refiner.h), the mapped frames re-attached to the refined keyframes
+  // (mapping/frame_reattachment.h). Leaves the online state as it is. A run of more than
+  // batch.max_keyframes keyframes is neither recorded nor solved (the solution is then empty and
+  // not usable, its report says why). Throws std::logic_error when batch_refinement is off.
   BatchSolution refineBatch() const;
   const BatchRecorder& batchRecorder() const { return batch_recorder_; }
 
