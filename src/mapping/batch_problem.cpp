@@ -174,8 +174,10 @@ std::map<int, LandmarkBlock> BatchProblem::freeLandmarkBlocks() const {
   return free_blocks;
 }
 
-std::map<int, Eigen::MatrixXd> BatchProblem::landmarkCovariances() {
-  return quadric_slam::landmarkCovariances(&problem_, freeLandmarkBlocks());
+std::map<int, Eigen::MatrixXd> BatchProblem::landmarkCovariances(
+    const std::vector<std::pair<int, int>>& pairs,
+    std::map<std::pair<int, int>, Eigen::MatrixXd>* cross) {
+  return quadric_slam::landmarkCovariances(&problem_, freeLandmarkBlocks(), pairs, cross);
 }
 
 std::map<std::pair<int, int>, Eigen::MatrixXd> BatchProblem::landmarkCrossCovariances(

@@ -20,43 +20,55 @@ double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// The refined estimates and covariances of the landmarks with a block in `problem`; a landmark
-// whose block is no valid quadric keeps its previous estimate (counted).
-void takeEstimates(bool compute_covariance, BatchProblem* problem,
-                   std::map<int, QuadricLandmark>* landmarks, BatchStatistics* stats) {
+// The refined estimates of the landmarks with a block in `problem` (a landmark whose block is no
+// valid quadric keeps its previous estimate, counted), with compute_covariance their covariances;
+// and the cross-covariances of the pairs among them whose extents touch, for the merger's test
+// (from the covariances' factorisation when there is one).
+void takeEstimates(bool compute_covariance, const LandmarkMerger& merger, BatchProblem* problem,
+                   std::map<int, QuadricLandmark>* landmarks, CrossCovariances* cross,
+                   BatchStatistics* stats) {
+  stats->invalid_landmarks = 0;
+  std::set<int> refined;  // free landmarks with a valid refined estimate
+  std::map<int, QuadricLandmark> solved;
+  for (auto& [id, landmark] : *landmarks) {
+    if (!problem->hasLandmark(id))
+      continue;
+    if (!problem->landmarkFixed(id)) {
+      try {
+        landmark.quadric_map = problem->landmarkEstimate(id, landmark.quadric_map);
+        refined.insert(id);
+      } catch (const std::invalid_argument&) {
+        ++stats->invalid_landmarks;
+      }
+    }
+    solved.emplace(id, landmark);
+  }
+  const std::vector<std::pair<int, int>> pairs = merger.nearPairs(solved);
   const auto start = std::chrono::steady_clock::now();
   std::map<int, Eigen::MatrixXd> covariances;
   if (compute_covariance)
-    covariances = problem->landmarkCovariances();
+    covariances = problem->landmarkCovariances(pairs, cross);
+  else
+    *cross = problem->landmarkCrossCovariances(pairs);
   stats->covariance_computed = !covariances.empty();
   stats->covariance_seconds += secondsSince(start);
-  stats->invalid_landmarks = 0;
   for (auto& [id, landmark] : *landmarks) {
-    if (!problem->hasLandmark(id) || problem->landmarkFixed(id))
-      continue;
-    try {
-      landmark.quadric_map = problem->landmarkEstimate(id, landmark.quadric_map);
-    } catch (const std::invalid_argument&) {
-      ++stats->invalid_landmarks;
-      continue;
-    }
     const auto c = covariances.find(id);
-    if (c != covariances.end())
+    if (c != covariances.end() && refined.count(id) > 0)
       landmark.covariance = c->second;
   }
 }
 
 // The pairs of refined landmarks (those with a block) that are the same surface, tested with their
 // cross-covariances in the problem (mapping/landmark_merger.h), by increasing d^2.
-std::vector<DuplicatePair> duplicatesIn(const LandmarkMerger& merger, BatchProblem* problem,
+std::vector<DuplicatePair> duplicatesIn(const LandmarkMerger& merger, const BatchProblem& problem,
                                         const std::map<int, QuadricLandmark>& landmarks,
-                                        CrossCovariances* cross) {
+                                        const CrossCovariances& cross) {
   std::map<int, QuadricLandmark> solved;
   for (const auto& [id, landmark] : landmarks)
-    if (problem->hasLandmark(id))
+    if (problem.hasLandmark(id))
       solved.emplace(id, landmark);
-  *cross = problem->landmarkCrossCovariances(merger.nearPairs(solved));
-  return merger.findDuplicates(solved, nullptr, cross);
+  return merger.findDuplicates(solved, nullptr, &cross);
 }
 
 // One pass of merges of `pairs`, applied to the problem (the survivor's block at the fused
@@ -142,14 +154,14 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
   if (!stats.solution_usable)
     return online();
   std::map<int, QuadricLandmark> landmarks = mapper.map().landmarks();
-  takeEstimates(params_.compute_covariance, &problem, &landmarks, &stats);
+  const LandmarkMerger& merger = mapper.map().merger();
+  CrossCovariances cross;
+  takeEstimates(params_.compute_covariance, merger, &problem, &landmarks, &cross, &stats);
 
   // Each surface once: refined surfaces, under honest covariances, may turn out to be one; merged,
   // and the problem solved again with their observations on one landmark.
-  const LandmarkMerger& merger = mapper.map().merger();
   for (int pass = 0;; ++pass) {
-    CrossCovariances cross;
-    solution.duplicates = duplicatesIn(merger, &problem, landmarks, &cross);
+    solution.duplicates = duplicatesIn(merger, problem, landmarks, cross);
     if (solution.duplicates.empty() || pass == params_.merge_rounds || !merger.params().enabled)
       break;
     const std::vector<LandmarkMerge> merges =
@@ -160,7 +172,7 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
     stats.solution_usable = problem.solve(params_, &stats);
     if (!stats.solution_usable)
       return online();
-    takeEstimates(params_.compute_covariance, &problem, &landmarks, &stats);
+    takeEstimates(params_.compute_covariance, merger, &problem, &landmarks, &cross, &stats);
   }
   stats.merged_landmarks = static_cast<int>(solution.merges.size());
 

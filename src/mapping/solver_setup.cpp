@@ -66,8 +66,10 @@ Eigen::MatrixXd acceptedCovariance(const Eigen::MatrixXd& covariance) {
   return symmetric;
 }
 
-std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
-                                                   const std::map<int, LandmarkBlock>& landmarks) {
+std::map<int, Eigen::MatrixXd> landmarkCovariances(
+    ceres::Problem* problem, const std::map<int, LandmarkBlock>& landmarks,
+    const std::vector<std::pair<int, int>>& pairs,
+    std::map<std::pair<int, int>, Eigen::MatrixXd>* cross) {
   std::map<int, Eigen::MatrixXd> out;
   // A window's poses (and landmarks tied by its marginalisation prior) make a dense part of a few
   // dozen to a few hundred variables: the Schur complement on them is cheaper than a sparse QR of
@@ -75,13 +77,26 @@ std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
   // ceres::Covariance with SPARSE_QR, the same covariances). A batch over hundreds of keyframes is
   // not: its dense part would be too large, and ceres::Covariance takes it.
   constexpr int kMaxSchurDenseSize = 300;
-  if (schurLandmarkCovariances(problem, landmarks, kMaxSchurDenseSize, &out))
+  if (schurLandmarkCovariances(problem, landmarks, kMaxSchurDenseSize, &out)) {
+    if (cross != nullptr)
+      *cross = landmarkCrossCovariances(problem, landmarks, pairs);
     return out;
+  }
   out.clear();
-  std::vector<std::pair<int, int>> diagonal;
+  std::vector<std::pair<int, int>> blocks;
   for (const auto& [id, block] : landmarks)
-    diagonal.emplace_back(id, id);
-  for (const auto& [pair, c] : ceresCovarianceBlocks(problem, landmarks, diagonal)) {
+    blocks.emplace_back(id, id);
+  if (cross != nullptr) {
+    cross->clear();
+    for (const auto& pair : pairs)
+      if (pair.first != pair.second)
+        blocks.push_back(pair);
+  }
+  for (const auto& [pair, c] : ceresCovarianceBlocks(problem, landmarks, blocks)) {
+    if (pair.first != pair.second) {
+      (*cross)[pair] = c;
+      continue;
+    }
     const Eigen::MatrixXd accepted = acceptedCovariance(c);
     if (accepted.size() > 0)
       out[pair.first] = accepted;

@@ -53,8 +53,10 @@ class BatchProblem {
   QuadricModel landmarkEstimate(int id, const QuadricModel& like) const;
   void setLandmarkEstimate(int id, const QuadricModel& estimate);
   // Marginal covariances of the free landmarks (mapping/solver_setup.h); empty when they cannot
-  // be computed.
-  std::map<int, Eigen::MatrixXd> landmarkCovariances();
+  // be computed. With `cross`, the cross-covariances of `pairs` too, from the same factorisation.
+  std::map<int, Eigen::MatrixXd> landmarkCovariances(
+      const std::vector<std::pair<int, int>>& pairs = {},
+      std::map<std::pair<int, int>, Eigen::MatrixXd>* cross = nullptr);
   // Cross-covariances of pairs of free landmarks (mapping/solver_setup.h); pairs with a constant
   // member, or that Ceres cannot give, are left out.
   std::map<std::pair<int, int>, Eigen::MatrixXd> landmarkCrossCovariances(

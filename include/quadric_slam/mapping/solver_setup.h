@@ -28,9 +28,13 @@ Eigen::MatrixXd acceptedCovariance(const Eigen::MatrixXd& covariance);
 
 // The marginal covariances of `landmarks` (id -> block) in their minimal tangent spaces, symmetric
 // and positive definite; an id whose block Ceres cannot give (e.g. a gauge left free) is left out,
-// and all are when the problem is rank-deficient.
-std::map<int, Eigen::MatrixXd> landmarkCovariances(ceres::Problem* problem,
-                                                   const std::map<int, LandmarkBlock>& landmarks);
+// and all are when the problem is rank-deficient. With `cross`, also the cross-covariances of
+// `pairs` (as landmarkCrossCovariances below), from the same factorisation when ceres::Covariance
+// computes the marginals: one sparse QR instead of two.
+std::map<int, Eigen::MatrixXd> landmarkCovariances(
+    ceres::Problem* problem, const std::map<int, LandmarkBlock>& landmarks,
+    const std::vector<std::pair<int, int>>& pairs = {},
+    std::map<std::pair<int, int>, Eigen::MatrixXd>* cross = nullptr);
 
 // Cross-covariances Cov(a, b) (rows: a's minimal tangent, columns: b's) of the requested pairs of
 // `landmarks` (ids), by ceres::Covariance (SPARSE_QR), keyed by the pair as given; a pair Ceres

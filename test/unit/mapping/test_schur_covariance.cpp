@@ -76,11 +76,13 @@ struct WindowLikeProblem {
 // 5 poses (the first constant), 8 landmarks (plane, sphere, cylinder, cone, repeated; the last
 // constant), each landmark seen from 3 poses; odometry between consecutive poses; a prior over
 // landmarks 0 and 1 and pose 2. rank_deficient: landmark 2 is seen by one 1-row residual only.
-void build(WindowLikeProblem* w, bool rank_deficient) {
+// num_poses > 5: a longer odometry chain (a batch's size: too large a dense part for the Schur
+// complement, so the covariances come from ceres::Covariance).
+void build(WindowLikeProblem* w, bool rank_deficient, int num_poses = 5) {
   std::mt19937 rng(11);
   const QuadricClass classes[] = {QuadricClass::kPlane, QuadricClass::kSphere,
                                   QuadricClass::kCylinder, QuadricClass::kCone};
-  w->poses.resize(5);
+  w->poses.resize(num_poses);
   for (auto& pose : w->poses) {
     poseToParameters(test::randomPose(rng), pose.data());
     w->problem.AddParameterBlock(pose.data(), kPoseParameterSize, &w->pose_manifold);
@@ -109,7 +111,7 @@ void build(WindowLikeProblem* w, bool rank_deficient) {
           w->poses[p].data(), w->landmarks[l].data());
     }
   }
-  for (int p = 1; p < 5; ++p)
+  for (int p = 1; p < num_poses; ++p)
     w->problem.AddResidualBlock(
         new RandomLinearCost({kPoseParameterSize, kPoseParameterSize}, 6, rng), nullptr,
         w->poses[p - 1].data(), w->poses[p].data());
@@ -205,6 +207,35 @@ TEST(LandmarkCrossCovariances, AgreeWithADenseCovarianceOfThePair) {
     EXPECT_GT(expected.norm(), 0.0);
     EXPECT_LE((got - Eigen::MatrixXd(expected)).norm(), 1e-8 * expected.norm())
         << pairs[i].first << "," << pairs[i].second;
+  }
+}
+
+// The batch asks for the marginals and the cross-covariances of its near pairs at once: the same
+// as asking for them apart, on the Schur path (a window's size) and on the ceres::Covariance one
+// (a batch's, where both come from one factorisation).
+TEST(LandmarkCrossCovariances, AskedWithTheMarginalsGiveTheSameAsApart) {
+  for (const int num_poses : {5, 60}) {
+    WindowLikeProblem w;
+    build(&w, false, num_poses);
+    std::map<int, Eigen::MatrixXd> out;
+    EXPECT_EQ(schurLandmarkCovariances(&w.problem, w.requested, 300, &out), num_poses == 5);
+    const std::vector<std::pair<int, int>> pairs = {{0, 1}, {1, 3}, {2, 5}, {6, 7}, {4, 4}};
+    std::map<std::pair<int, int>, Eigen::MatrixXd> cross;
+    const std::map<int, Eigen::MatrixXd> marginals =
+        landmarkCovariances(&w.problem, w.requested, pairs, &cross);
+    const std::map<int, Eigen::MatrixXd> marginals_apart =
+        landmarkCovariances(&w.problem, w.requested);
+    const std::map<std::pair<int, int>, Eigen::MatrixXd> cross_apart =
+        landmarkCrossCovariances(&w.problem, w.requested, pairs);
+    ASSERT_EQ(marginals.size(), w.requested.size()) << num_poses;
+    ASSERT_EQ(marginals_apart.size(), marginals.size()) << num_poses;
+    for (const auto& [id, c] : marginals_apart)
+      EXPECT_LE((marginals.at(id) - c).norm(), 1e-8 * c.norm()) << num_poses << " " << id;
+    EXPECT_EQ(cross.size(), 3u) << "landmark 7 is constant; (4, 4) is a marginal";
+    ASSERT_EQ(cross_apart.size(), cross.size()) << num_poses;
+    for (const auto& [pair, c] : cross_apart)
+      EXPECT_LE((cross.at(pair) - c).norm(), 1e-8 * c.norm())
+          << num_poses << " " << pair.first << "," << pair.second;
   }
 }
 
