@@ -22,6 +22,14 @@ bool smallCorrection(const Vector6d& delta) {
          delta.tail<3>().norm() <= kMaxChainRotation;
 }
 
+Eigen::Isometry3d chainEnd(const Eigen::Isometry3d& X_start,
+                           const std::vector<Eigen::Isometry3d>& steps) {
+  Eigen::Isometry3d X = X_start;
+  for (const Eigen::Isometry3d& step : steps)
+    X = X * step;
+  return X;
+}
+
 std::vector<Eigen::Isometry3d> composeChain(const Eigen::Isometry3d& X_start,
                                             const std::vector<Eigen::Isometry3d>& steps) {
   std::vector<Eigen::Isometry3d> poses;
@@ -50,8 +58,7 @@ std::vector<Eigen::Isometry3d> smoothOdometryChain(const Eigen::Isometry3d& X_st
   std::vector<Vector6d> xi(n, Vector6d::Zero());
   std::vector<Matrix6d> J(n);
   for (int iteration = 0; iteration < kChainIterations; ++iteration) {
-    const Eigen::Isometry3d X_chain_end = composeChain(X_start, steps).back();
-    const Vector6d delta = logSE3(X_chain_end.inverse() * X_end);
+    const Vector6d delta = logSE3(chainEnd(X_start, steps).inverse() * X_end);
     if (delta.norm() < 1e-12)
       break;
     // J_i = Ad(P_i^-1): a perturbation right of step i seen at the chain's end.
@@ -111,8 +118,7 @@ std::vector<RefinedPose> reattachFrames(const BatchRecorder& recorder,
       }
       const Eigen::Isometry3d& X_start = keyframe_poses[frames[start].keyframe];
       const Eigen::Isometry3d& X_end = keyframe_poses[frames[f].keyframe];
-      const Eigen::Isometry3d X_predicted = composeChain(X_start, increments).back();
-      if (smallCorrection(logSE3(X_predicted.inverse() * X_end))) {
+      if (smallCorrection(logSE3(chainEnd(X_start, increments).inverse() * X_end))) {
         const std::vector<Eigen::Isometry3d> chain =
             smoothOdometryChain(X_start, increments, covariances, X_end);
         for (std::size_t k = start + 1; k < f; ++k)

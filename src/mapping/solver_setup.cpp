@@ -47,6 +47,15 @@ std::map<std::pair<int, int>, Eigen::MatrixXd> ceresCovarianceBlocks(
   return out;
 }
 
+// The pairs of two different landmarks among `pairs` (a pair of one landmark is its marginal).
+std::vector<std::pair<int, int>> crossPairs(const std::vector<std::pair<int, int>>& pairs) {
+  std::vector<std::pair<int, int>> distinct;
+  for (const auto& pair : pairs)
+    if (pair.first != pair.second)
+      distinct.push_back(pair);
+  return distinct;
+}
+
 }  // namespace
 
 ceres::Solver::Options landmarkSolverOptions(int max_iterations) {
@@ -88,9 +97,8 @@ std::map<int, Eigen::MatrixXd> landmarkCovariances(
     blocks.emplace_back(id, id);
   if (cross != nullptr) {
     cross->clear();
-    for (const auto& pair : pairs)
-      if (pair.first != pair.second)
-        blocks.push_back(pair);
+    const std::vector<std::pair<int, int>> distinct = crossPairs(pairs);
+    blocks.insert(blocks.end(), distinct.begin(), distinct.end());
   }
   for (const auto& [pair, c] : ceresCovarianceBlocks(problem, landmarks, blocks)) {
     if (pair.first != pair.second) {
@@ -107,11 +115,7 @@ std::map<int, Eigen::MatrixXd> landmarkCovariances(
 std::map<std::pair<int, int>, Eigen::MatrixXd> landmarkCrossCovariances(
     ceres::Problem* problem, const std::map<int, LandmarkBlock>& landmarks,
     const std::vector<std::pair<int, int>>& pairs) {
-  std::vector<std::pair<int, int>> distinct;
-  for (const auto& pair : pairs)
-    if (pair.first != pair.second)
-      distinct.push_back(pair);
-  return ceresCovarianceBlocks(problem, landmarks, distinct);
+  return ceresCovarianceBlocks(problem, landmarks, crossPairs(pairs));
 }
 
 }  // namespace quadric_slam

@@ -13,9 +13,9 @@
 // the odometry so lands on the steps the odometry was least sure of (a degenerate frame takes the
 // slide along its weak direction) instead of being carried forward from the earlier keyframe.
 // Frames after the last keyframe hang from it through their odometry; frames before the first
-// keep their online estimates. A chain whose disagreement is not small (more than
-// max_chain_rotation, e.g. across a relocalisation that the odometry did not follow) or whose
-// increments carry no covariance falls back to hanging from its earlier keyframe.
+// keep their online estimates. A chain whose disagreement is not small (more than 0.5 rad or 1 m,
+// e.g. across a relocalisation that the odometry did not follow) or whose increments carry no
+// covariance falls back to hanging from its earlier keyframe.
 #pragma once
 
 #include <Eigen/Core>
