@@ -1,6 +1,7 @@
 #include "quadric_slam/frontend/curved_verification.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <optional>
 
@@ -9,6 +10,7 @@
 #include "quadric_slam/frontend/curved_shape_starts.h"
 #include "quadric_slam/frontend/ellipsoid_candidate.h"
 #include "quadric_slam/frontend/general_quadric_fit.h"
+#include "quadric_slam/frontend/parallel_chunks.h"
 #include "quadric_slam/frontend/plane_region_grower.h"
 
 namespace quadric_slam {
@@ -176,12 +178,9 @@ bool generalQuadricIsSurface(const GeneralQuadricFit& general, const Segmentatio
 // its 9 minimal parameters on them. None when the fit is no plausible ellipsoid, the refinement
 // fails or leaves the plausible sizes, the support is too small, or the RMS exceeds the curved
 // shapes' limit (max_rms_factor). *indices receives the support.
-std::optional<ShapeRefiner::Result> detectEllipsoid(const SegmentationFrame& frame,
-                                                    const GeneralQuadricFit& general,
-                                                    const ImageRoi& roi,
-                                                    const QuadricSegmenter::Params& p,
-                                                    const ShapeRefiner& refiner,
-                                                    std::vector<int>* indices) {
+std::optional<ShapeRefiner::Result> detectEllipsoid(
+    const SegmentationFrame& frame, const GeneralQuadricFit& general, const ImageRoi& roi,
+    const QuadricSegmenter::Params& p, const ShapeRefiner& refiner, std::vector<int>* indices) {
   const std::optional<PrimitiveShape> start =
       ellipsoidCandidate(general, p.min_sphere_radius, p.max_sphere_radius);
   if (!start)
@@ -204,94 +203,180 @@ std::optional<ShapeRefiner::Result> detectEllipsoid(const SegmentationFrame& fra
   return fit;
 }
 
-}  // namespace
+// What verifying one candidate decided, and the box of pixels whose used flags the decision read
+// (the candidate's own samples, the windows searched for its support): the decision stays the same
+// as long as no pixel inside that box is taken by another detection.
+struct CandidateVerdict {
+  bool decided = false;  // false: not verified yet (or its speculative verification threw)
+  bool accepted = false;
+  std::vector<int> indices;
+  ShapeRefiner::Result fit;
+  ImageRoi read_box;
+};
 
-void verifyCurvedCandidates(const SegmentationFrame& frame, const CurvedCandidates& candidates,
-                            const QuadricSegmenter::Params& p, const ShapeRefiner& refiner,
-                            const AcceptDetection& accept) {
+CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
+                                 const CgalShapeDetector::Shape& candidate,
+                                 const CurvedCandidates& candidates,
+                                 const QuadricSegmenter::Params& p, const ShapeRefiner& refiner) {
   const pcl::PointCloud<pcl::PointNormal>& cloud = frame.cloud;
   const int width = frame.width, height = frame.height;
-  for (const CgalShapeDetector::Shape& candidate : candidates.shapes) {
-    if (candidate.shape.quadric_class == QuadricClass::kPlane)
+  CandidateVerdict verdict;
+  verdict.decided = true;
+  std::vector<int> all_pixels;
+  all_pixels.reserve(candidate.indices.size());
+  for (int k : candidate.indices)
+    all_pixels.push_back(candidates.pixels[k]);
+  verdict.read_box = roiOf(all_pixels, width);
+  std::vector<Eigen::Vector3d> support;
+  std::vector<int> pixels;
+  for (int k : candidate.indices) {
+    if (frame.used[candidates.pixels[k]])
       continue;
-    std::vector<Eigen::Vector3d> support;
-    std::vector<int> pixels;
-    for (int k : candidate.indices) {
-      if (frame.used[candidates.pixels[k]])
-        continue;
-      support.push_back(candidates.points[k]);
-      pixels.push_back(candidates.pixels[k]);
-    }
-    if (static_cast<int>(support.size()) < p.cgal_min_points)
-      continue;
-    PrimitiveShape shape = candidate.shape;
-    if (shape.quadric_class == QuadricClass::kCone && shape.size < p.min_cone_half_angle)
-      shape = cylinderFromCone(shape, support);
-    ShapeRefiner::Result fit = refiner.refine(shape, support);
-    const ImageRoi roi = grown(roiOf(pixels, width), 4 * p.cgal_stride, width, height);
-
-    std::vector<int> indices;
-    for (int pass = 0; pass < 2; ++pass) {
-      if (!plausibleShape(fit.shape, p))
-        break;
-      indices = assignLargestComponent(frame, fit.shape, roi, p);
-      if (static_cast<int>(indices.size()) < p.min_curved_points) {
-        indices.clear();
-        break;
-      }
-      const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
-      fit = refiner.refine(fit.shape, points);
-      // Model selection on the first support only: the second pass re-assigns the pixels with
-      // the chosen class and refines it there (selecting again there changed nothing measurable
-      // on the generated scenes' recall, at a third of the verification's time).
-      if (pass == 0) {
-        std::vector<Eigen::Vector3d> normals;
-        normals.reserve(indices.size());
-        for (int i : indices)
-          normals.push_back(normalOf(cloud.points[i]).normalized());
-        fit = selectCurvedModel(fit, points, normals, p, refiner);
-      }
-    }
-    if (indices.empty() || !plausibleShape(fit.shape, p))
-      continue;
-    const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
-    // Degeneracy: a near-flat surface is a plane, not a curved primitive. Flat means what it means
-    // to the plane region grower: the plane fits almost as well AND the normals do not bend (shape
-    // operator at most the grower's max_curvature). The normals decide when the depth noise hides
-    // the sag (a far cylinder seen over a narrow arc); without them such a surface would be
-    // neither a plane (the grower rejects it as curved) nor a curved primitive.
-    const PrimitiveShape plane = fitPlane(points);
-    if (rmsDistance(plane, points) < p.plane_rms_ratio * fit.rms &&
-        !normalsBendLike(patchCurvature(cloud, indices, plane.direction),
-                         shapeCurvature(fit.shape, points), p))
-      continue;
-    // Shape test: residuals well above a general quadric's are shape (e.g. an ellipsoid), not
-    // noise. Only when the general quadric is a surface through the points: when the depth noise
-    // is large against the patch's curvature (a far, narrow strip of a cylinder), its 10
-    // coefficients fit the noise band instead, with two close sheets that split neighbouring
-    // points, and its RMS drops well below the noise that any true surface leaves. The primitive
-    // is dropped; an ellipsoid found there is reported instead (before the primitive's RMS limit:
-    // a sphere on an elongated ellipsoid may well exceed it).
-    const GeneralQuadricFit general = fitGeneralQuadric(points);
-    if (general.ok && fit.rms > p.quadric_rms_ratio * general.rms &&
-        generalQuadricIsSurface(general, frame, indices, roiOf(indices, width))) {
-      if (p.detect_general) {
-        std::vector<int> general_indices;
-        const std::optional<ShapeRefiner::Result> ellipsoid =
-            detectEllipsoid(frame, general, unite(roi, grown(roiOf(indices, width),
-                                                              4 * p.cgal_stride, width, height)),
-                            p, refiner, &general_indices);
-        if (ellipsoid)
-          accept(general_indices, *ellipsoid);
-      }
-      continue;
-    }
-    const double z = medianDepth(cloud, indices);
-    if (fit.rms >
-        p.max_rms_factor * depthThreshold(z, p.planes.distance_factor, p.planes.min_distance))
-      continue;
-    accept(indices, fit);
+    support.push_back(candidates.points[k]);
+    pixels.push_back(candidates.pixels[k]);
   }
+  if (static_cast<int>(support.size()) < p.cgal_min_points)
+    return verdict;
+  PrimitiveShape shape = candidate.shape;
+  if (shape.quadric_class == QuadricClass::kCone && shape.size < p.min_cone_half_angle)
+    shape = cylinderFromCone(shape, support);
+  ShapeRefiner::Result fit = refiner.refine(shape, support);
+  const ImageRoi roi = grown(roiOf(pixels, width), 4 * p.cgal_stride, width, height);
+  verdict.read_box = unite(verdict.read_box, roi);
+
+  std::vector<int> indices;
+  for (int pass = 0; pass < 2; ++pass) {
+    if (!plausibleShape(fit.shape, p))
+      break;
+    indices = assignLargestComponent(frame, fit.shape, roi, p);
+    if (static_cast<int>(indices.size()) < p.min_curved_points) {
+      indices.clear();
+      break;
+    }
+    const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
+    fit = refiner.refine(fit.shape, points);
+    // Model selection on the first support only: the second pass re-assigns the pixels with
+    // the chosen class and refines it there (selecting again there changed nothing measurable
+    // on the generated scenes' recall, at a third of the verification's time).
+    if (pass == 0) {
+      std::vector<Eigen::Vector3d> normals;
+      normals.reserve(indices.size());
+      for (int i : indices)
+        normals.push_back(normalOf(cloud.points[i]).normalized());
+      fit = selectCurvedModel(fit, points, normals, p, refiner);
+    }
+  }
+  if (indices.empty() || !plausibleShape(fit.shape, p))
+    return verdict;
+  const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
+  // Degeneracy: a near-flat surface is a plane, not a curved primitive. Flat means what it means
+  // to the plane region grower: the plane fits almost as well AND the normals do not bend (shape
+  // operator at most the grower's max_curvature). The normals decide when the depth noise hides
+  // the sag (a far cylinder seen over a narrow arc); without them such a surface would be
+  // neither a plane (the grower rejects it as curved) nor a curved primitive.
+  const PrimitiveShape plane = fitPlane(points);
+  if (rmsDistance(plane, points) < p.plane_rms_ratio * fit.rms &&
+      !normalsBendLike(patchCurvature(cloud, indices, plane.direction),
+                       shapeCurvature(fit.shape, points), p))
+    return verdict;
+  // Shape test: residuals well above a general quadric's are shape (e.g. an ellipsoid), not
+  // noise. Only when the general quadric is a surface through the points: when the depth noise
+  // is large against the patch's curvature (a far, narrow strip of a cylinder), its 10
+  // coefficients fit the noise band instead, with two close sheets that split neighbouring
+  // points, and its RMS drops well below the noise that any true surface leaves. The primitive
+  // is dropped; an ellipsoid found there is reported instead (before the primitive's RMS limit:
+  // a sphere on an elongated ellipsoid may well exceed it).
+  const GeneralQuadricFit general = fitGeneralQuadric(points);
+  if (general.ok && fit.rms > p.quadric_rms_ratio * general.rms &&
+      generalQuadricIsSurface(general, frame, indices, roiOf(indices, width))) {
+    if (p.detect_general) {
+      std::vector<int> general_indices;
+      const ImageRoi ellipsoid_roi =
+          unite(roi, grown(roiOf(indices, width), 4 * p.cgal_stride, width, height));
+      verdict.read_box = unite(verdict.read_box, ellipsoid_roi);
+      const std::optional<ShapeRefiner::Result> ellipsoid =
+          detectEllipsoid(frame, general, ellipsoid_roi, p, refiner, &general_indices);
+      if (ellipsoid) {
+        verdict.accepted = true;
+        verdict.indices = std::move(general_indices);
+        verdict.fit = *ellipsoid;
+      }
+    }
+    return verdict;
+  }
+  const double z = medianDepth(cloud, indices);
+  if (fit.rms >
+      p.max_rms_factor * depthThreshold(z, p.planes.distance_factor, p.planes.min_distance))
+    return verdict;
+  verdict.accepted = true;
+  verdict.indices = std::move(indices);
+  verdict.fit = fit;
+  return verdict;
+}
+
+bool intersects(const ImageRoi& a, const ImageRoi& b) {
+  return a.x_offset < b.x_offset + b.width && b.x_offset < a.x_offset + a.width &&
+         a.y_offset < b.y_offset + b.height && b.y_offset < a.y_offset + a.height;
+}
+
+}  // namespace
+
+int verifyCurvedCandidates(const SegmentationFrame& frame, const CurvedCandidates& candidates,
+                           const QuadricSegmenter::Params& p, const ShapeRefiner& refiner,
+                           const AcceptDetection& accept) {
+  std::vector<const CgalShapeDetector::Shape*> curved;
+  for (const CgalShapeDetector::Shape& candidate : candidates.shapes)
+    if (candidate.shape.quadric_class != QuadricClass::kPlane)
+      curved.push_back(&candidate);
+  const int n = static_cast<int>(curved.size());
+  // The verdicts depend on each other only through the pixels that accepted candidates take. All
+  // are first verified in parallel against the free pixels as they are before this stage; then,
+  // in order, a verdict is kept when no pixel taken since lies inside the box it read, and
+  // verified again otherwise. The result is the sequential one, whatever the number of threads.
+  std::vector<CandidateVerdict> verdicts(n);
+  if (p.threads > 1 && n > 1) {
+    std::atomic<int> next{0};
+    forEachChunk(p.threads, p.threads, [&](int, int, int) {
+      for (int k = next++; k < n; k = next++) {
+        try {
+          verdicts[k] = verifyCandidate(frame, *curved[k], candidates, p, refiner);
+        } catch (...) {  // left undecided: verified again in order below, where it may throw
+          verdicts[k] = CandidateVerdict();
+        }
+      }
+    });
+  }
+  struct Taken {
+    ImageRoi box;
+    std::vector<int> pixels;
+  };
+  std::vector<Taken> taken;
+  const auto touchesTaken = [&](const ImageRoi& box) {
+    for (const Taken& t : taken) {
+      if (!intersects(t.box, box))
+        continue;
+      for (int i : t.pixels) {
+        const int u = i % frame.width, v = i / frame.width;
+        if (u >= box.x_offset && u < box.x_offset + box.width && v >= box.y_offset &&
+            v < box.y_offset + box.height)
+          return true;
+      }
+    }
+    return false;
+  };
+  int verified_again = 0;
+  for (int k = 0; k < n; ++k) {
+    CandidateVerdict verdict = std::move(verdicts[k]);
+    const bool stale = verdict.decided && touchesTaken(verdict.read_box);
+    verified_again += stale;
+    if (!verdict.decided || stale)
+      verdict = verifyCandidate(frame, *curved[k], candidates, p, refiner);
+    if (!verdict.accepted)
+      continue;
+    accept(verdict.indices, verdict.fit);
+    taken.push_back(Taken{roiOf(verdict.indices, frame.width), std::move(verdict.indices)});
+  }
+  return verified_again;
 }
 
 }  // namespace quadric_slam

@@ -157,8 +157,8 @@ Segmentation segmentCurvedCoarser(const SegmentationFrame& frame, const QuadricS
   timings.ransac_candidates = static_cast<int>(candidates.shapes.size());
   timings.ransac_ms = msSince(start);
   start = std::chrono::steady_clock::now();
-  verifyCurvedCandidates(coarse_frame, candidates, coarse_params, refiner,
-                         acceptInto(coarse_frame, coarse));
+  timings.curved_verified_again = verifyCurvedCandidates(coarse_frame, candidates, coarse_params,
+                                                         refiner, acceptInto(coarse_frame, coarse));
   // The curved segments take only the free points of frame's grid: the others (planes, invalid)
   // are hidden from the labelling.
   pcl::PointCloud<pcl::PointNormal> free_points = frame.cloud;
@@ -234,7 +234,8 @@ Segmentation segmentGrid(const pcl::PointCloud<pcl::PointNormal>& cloud,
 
   // 3. Each curved candidate verified, refined and re-assigned, biggest first
   // (curved_verification.h).
-  verifyCurvedCandidates(frame, candidates, p, refiner, accept);
+  result.timings.curved_verified_again =
+      verifyCurvedCandidates(frame, candidates, p, refiner, accept);
   result.timings.verify_ms = msSince(start);
   return result;
 }

@@ -37,9 +37,12 @@ void centreOnSupport(PrimitiveShape& s, const std::vector<Eigen::Vector3d>& poin
 using AcceptDetection =
     std::function<void(const std::vector<int>& indices, const ShapeRefiner::Result& fit)>;
 
-// Verifies the candidates in order (biggest first), calling accept for each one kept.
-void verifyCurvedCandidates(const SegmentationFrame& frame, const CurvedCandidates& candidates,
-                            const QuadricSegmenter::Params& p, const ShapeRefiner& refiner,
-                            const AcceptDetection& accept);
+// Verifies the candidates in order (biggest first), calling accept for each one kept. With
+// p.threads > 1 the verdicts are first reached in parallel against the free pixels before this
+// stage; one whose read pixels an earlier kept candidate took is verified again in order, so the
+// result is the sequential one. Returns how many were verified again.
+int verifyCurvedCandidates(const SegmentationFrame& frame, const CurvedCandidates& candidates,
+                           const QuadricSegmenter::Params& p, const ShapeRefiner& refiner,
+                           const AcceptDetection& accept);
 
 }  // namespace quadric_slam

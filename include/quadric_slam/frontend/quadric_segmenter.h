@@ -69,6 +69,8 @@ struct SegmentationTimings {
   double boundary_ms = 0.0;   // labels of boundary points without normals (boundary_labels.h)
   int ransac_points = 0;      // points given to CGAL
   int ransac_candidates = 0;  // shapes CGAL returned
+  int curved_verified_again =
+      0;  // verdicts reached in parallel, then redone in order (threads > 1)
 };
 
 struct Segmentation {

@@ -234,3 +234,48 @@ TEST(QuadricSegmenterReal, Fr3GlobeWithCurvedShapesOnACoarserGrid) {
   params.curved_decimation = 2;
   checkFr3GlobeDeskAndFloor(params);
 }
+
+// The curved candidates are verified in parallel, and again in order where an earlier kept one
+// took pixels that a verdict read: the segmentation with two threads is the one with one, on the
+// shipped TUM frames, where that happens.
+TEST(QuadricSegmenterReal, ParallelCurvedVerificationGivesTheSequentialSegmentation) {
+  int verified_again = 0, curved = 0;
+  for (const auto& entry :
+       std::filesystem::recursive_directory_iterator(qs::test::shippedData("tum_frames"))) {
+    // Depth frames only (a colour image lies beside them).
+    if (entry.path().extension() != ".png" ||
+        cv::imread(entry.path().string(), cv::IMREAD_UNCHANGED).depth() != CV_16U)
+      continue;
+    const std::string sequence = entry.path().parent_path().filename().string();
+    const cv::Mat depth_m = qs::readTumDepthPng(entry.path().string());
+    qs::CameraIntrinsics k = qs::tumIntrinsicsForSequence(sequence);
+    k.width = depth_m.cols;
+    k.height = depth_m.rows;
+    const auto cloud = qs::NormalEstimator(qs::NormalEstimator::Params())
+                           .compute(qs::backProject(qs::depthViewOf(depth_m), k, {}));
+    qs::QuadricSegmenter::Params params;
+    params.threads = 1;
+    const qs::Segmentation one = qs::QuadricSegmenter(params).segment(cloud);
+    params.threads = 2;
+    const qs::Segmentation two = qs::QuadricSegmenter(params).segment(cloud);
+    const std::string frame = entry.path().string();
+    EXPECT_EQ(one.timings.curved_verified_again, 0) << frame;
+    verified_again += two.timings.curved_verified_again;
+    ASSERT_EQ(one.detections.size(), two.detections.size()) << frame;
+    EXPECT_EQ(cv::countNonZero(one.labels != two.labels), 0) << frame;
+    for (std::size_t i = 0; i < one.detections.size(); ++i) {
+      const qs::QuadricDetection &a = one.detections[i], &b = two.detections[i];
+      curved += a.shape.quadric_class != QuadricClass::kPlane;
+      EXPECT_EQ(a.shape.quadric_class, b.shape.quadric_class) << frame << " #" << i;
+      EXPECT_EQ(a.shape.point, b.shape.point) << frame << " #" << i;
+      EXPECT_EQ(a.shape.direction, b.shape.direction) << frame << " #" << i;
+      EXPECT_EQ(a.shape.size, b.shape.size) << frame << " #" << i;
+      EXPECT_EQ(a.num_points, b.num_points) << frame << " #" << i;
+      // The full-resolution tallies are summed per thread: the last bits may differ.
+      EXPECT_NEAR(a.fit_rms, b.fit_rms, 1e-12) << frame << " #" << i;
+    }
+  }
+  std::printf("%d curved detections, %d verdicts verified again\n", curved, verified_again);
+  EXPECT_GT(curved, 5);
+  EXPECT_GT(verified_again, 0) << "no frame took the path of verifying again";
+}
