@@ -47,21 +47,43 @@ Eigen::VectorXd residuals(const PrimitiveShape& shape, const std::vector<Eigen::
   return r;
 }
 
-// Jacobian of the distances with respect to the minimal coordinates, by central differences.
-Eigen::MatrixXd numericJacobian(const PrimitiveShape& shape,
-                                const std::vector<Eigen::Vector3d>& points) {
-  const int k = minimalDimension(shape.quadric_class);
-  Eigen::MatrixXd J(points.size(), k);
-  constexpr double h = 1e-6;
-  for (int j = 0; j < k; ++j) {
-    Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
-    delta[j] = h;
-    const Eigen::VectorXd plus = residuals(perturb(shape, delta), points);
-    delta[j] = -h;
-    const Eigen::VectorXd minus = residuals(perturb(shape, delta), points);
-    J.col(j) = (plus - minus) / (2 * h);
+using Vector9d = Eigen::Matrix<double, 9, 1>;
+
+// Gradient of a general quadric's first-order distance d = f / max(|grad f|, 1e-9)
+// (PrimitiveShape::curvedDistance) with respect to its 9 minimal coordinates at zero: the pose
+// step (rho, phi) of T exp(xi) (eqs. 9, 16) and the step of the scales (alpha, beta, gamma). In the
+// quadric frame the point is x = T^-1 p, which the pose step moves to exp(xi)^-1 x, to first order
+// x - rho + x cross phi. With y = S x and signature sigma: f = y^T D(sigma) y + sigma_4 and
+// grad f = 2 w in the quadric frame, w = D(sigma) S^2 x; so df/dx = 2 w, df/dS = 2 D(sigma) S x^2,
+// d|grad f| = 2 u^T dw with u = w / |w|, dw/dx = D(sigma) S^2, dw/dS = 2 D(sigma) D(S x).
+Vector9d generalDistanceGradient(const QuadricModel& q, const Eigen::Vector3d& p) {
+  const Eigen::Isometry3d& T = q.pose();
+  const Eigen::Vector3d x = T.linear().transpose() * (p - T.translation());
+  const Eigen::Vector3d s = q.scale();
+  const Eigen::Vector3d sigma = q.signature().head<3>();
+  const Eigen::Vector3d sigma_s = sigma.cwiseProduct(s);
+  const Eigen::Vector3d w = sigma_s.cwiseProduct(s).cwiseProduct(x);
+  const double f = sigma_s.cwiseProduct(s).dot(x.cwiseAbs2()) + q.signature()[3];
+  const Eigen::Vector3d df_dx = 2.0 * w;
+  const Eigen::Vector3d df_ds = 2.0 * sigma_s.cwiseProduct(x.cwiseAbs2());
+  const double w_norm = w.norm();
+  const double g = 2.0 * w_norm;
+  Eigen::Vector3d dd_dx, dd_ds;
+  if (g > 1e-9) {
+    const Eigen::Vector3d u = w / w_norm;
+    const Eigen::Vector3d dg_dx = 2.0 * sigma_s.cwiseProduct(s).cwiseProduct(u);
+    const Eigen::Vector3d dg_ds = 4.0 * sigma_s.cwiseProduct(x).cwiseProduct(u);
+    dd_dx = df_dx / g - f * dg_dx / (g * g);
+    dd_ds = df_ds / g - f * dg_ds / (g * g);
+  } else {  // the floor of the gradient's norm: d = f / 1e-9
+    dd_dx = df_dx / 1e-9;
+    dd_ds = df_ds / 1e-9;
   }
-  return J;
+  Vector9d gradient;
+  gradient.head<3>() = -dd_dx;
+  gradient.segment<3>(3) = dd_dx.cross(x);
+  gradient.tail<3>() = dd_ds;
+  return gradient;
 }
 
 // d (point, direction, size) / d delta at delta = 0 for the minimal perturbation of a plane,
@@ -112,9 +134,15 @@ struct DistanceChain {
 void normalEquations(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points,
                      const Eigen::VectorXd& r, Eigen::MatrixXd& H, Eigen::VectorXd& g) {
   if (shape.quadric_class == QuadricClass::kGeneral) {
-    const Eigen::MatrixXd J = distanceJacobian(shape, points);
-    H = J.transpose() * J;
-    g = J.transpose() * r;
+    Eigen::Matrix<double, 9, 9> HH = Eigen::Matrix<double, 9, 9>::Zero();
+    Vector9d gg = Vector9d::Zero();
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Vector9d row = generalDistanceGradient(shape.general_quadric, points[i]);
+      HH.noalias() += row * row.transpose();
+      gg.noalias() += row * r[static_cast<Eigen::Index>(i)];
+    }
+    H = HH;
+    g = gg;
     return;
   }
   // J = G D with G the per-point gradients in (point, direction, size): accumulate the fixed-size
@@ -240,8 +268,13 @@ ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
 
 Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
                                  const std::vector<Eigen::Vector3d>& points) {
-  if (shape.quadric_class == QuadricClass::kGeneral)
-    return numericJacobian(shape, points);
+  if (shape.quadric_class == QuadricClass::kGeneral) {
+    Eigen::MatrixXd J(points.size(), 9);
+    for (std::size_t i = 0; i < points.size(); ++i)
+      J.row(static_cast<Eigen::Index>(i)) =
+          generalDistanceGradient(shape.general_quadric, points[i]).transpose();
+    return J;
+  }
   // Row by row with D on the stack: no heap temporary per row (and a general matrix product of
   // n x 7 by 7 x k costs more in packing than it saves).
   const DistanceChain chain(shape);

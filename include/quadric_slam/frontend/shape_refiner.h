@@ -53,8 +53,9 @@ class ShapeRefiner {
 // Jacobian (points x minimalDimension) of the signed distances of points to shape with respect to
 // the minimal perturbation of primitive_shape.h (perturb, Table II order) at zero. Plane, sphere,
 // cylinder, cone: analytic, per point PrimitiveShape::distanceGradient chained with the 7 x k
-// derivative of (point, direction, size) in the perturbation (closed form at zero); general:
-// central differences. Throws std::invalid_argument when the shape has no core quadric.
+// derivative of (point, direction, size) in the perturbation (closed form at zero); general: the
+// first-order distance's gradient in the 9 coordinates (pose step and scales), closed form too.
+// Throws std::invalid_argument when the shape has no core quadric.
 Eigen::MatrixXd distanceJacobian(const PrimitiveShape& shape,
                                  const std::vector<Eigen::Vector3d>& points);
 

@@ -274,3 +274,41 @@ TEST(ShapeRefiner, AnalyticDistanceJacobianMatchesNumericDifferentiation) {
     }
   }
 }
+
+// The same for general quadrics (an ellipsoid, a hyperboloid of one sheet), whose distance is the
+// first-order f / |grad f|: the closed-form 9-coordinate Jacobian against central differences
+// through perturb, at points scattered around the surface (off it by up to a few cm).
+TEST(ShapeRefiner, GeneralQuadricDistanceJacobianMatchesNumericDifferentiation) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.3, -1, 0.4).normalized()).matrix();
+  T.translation() = Eigen::Vector3d(0.2, -0.1, 1.6);
+  const std::vector<PrimitiveShape> shapes = {
+      PrimitiveShape::general(qs::QuadricModel(QuadricClass::kGeneral, T,
+                                               Eigen::Vector3d(1 / 0.25, 1 / 0.15, 1 / 0.1))),
+      PrimitiveShape::general(qs::QuadricModel(QuadricClass::kGeneral, T,
+                                               Eigen::Vector3d(1 / 0.2, 1 / 0.3, 1 / 0.5),
+                                               Eigen::Vector4d(1, 1, -1, -1)))};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> uni(-0.4, 0.4);
+  for (const PrimitiveShape& s : shapes) {
+    std::vector<Eigen::Vector3d> points;
+    for (int i = 0; i < 80; ++i)
+      points.push_back(T * Eigen::Vector3d(uni(rng), uni(rng), uni(rng)));
+    const Eigen::MatrixXd J = qs::distanceJacobian(s, points);
+    ASSERT_EQ(J.cols(), 9);
+    constexpr double h = 1e-6;
+    for (int j = 0; j < 9; ++j) {
+      Eigen::VectorXd delta = Eigen::VectorXd::Zero(9);
+      delta[j] = h;
+      const PrimitiveShape plus = qs::perturb(s, delta);
+      delta[j] = -h;
+      const PrimitiveShape minus = qs::perturb(s, delta);
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const double numeric = (plus.distance(points[i]) - minus.distance(points[i])) / (2 * h);
+        EXPECT_NEAR(J(static_cast<Eigen::Index>(i), j), numeric, 1e-6 * (1 + std::abs(numeric)))
+            << "signature " << s.general_quadric.signature().transpose() << " point " << i
+            << " coordinate " << j;
+      }
+    }
+  }
+}
