@@ -183,8 +183,16 @@ BatchSolution BatchRefiner::refine(const BatchRecorder& recorder,
     stats.observation_residual_median = norms[norms.size() / 2];
     stats.observation_residual_p95 = norms[std::min(norms.size() - 1, norms.size() * 95 / 100)];
   }
-  for (const auto& [id, landmark] : landmarks)
-    solution.landmarks.push_back(landmark);
+  // A landmark that no keyframe observes (all its observations made on frames between keyframes)
+  // has no block: the batch can neither refine it nor test it against the other landmarks, so the
+  // refined map leaves it out (as keyframe-based SLAM culls map points seen from too few
+  // keyframes).
+  for (const auto& [id, landmark] : landmarks) {
+    if (problem.hasLandmark(id))
+      solution.landmarks.push_back(landmark);
+    else
+      ++stats.unobserved_landmarks;
+  }
   solution.trajectory = reattachFrames(recorder, solution.keyframe_poses);
   stats.solve_seconds = secondsSince(start) - stats.covariance_seconds;
   return solution;

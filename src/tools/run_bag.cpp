@@ -286,6 +286,8 @@ std::vector<qs::QuadricLandmark> refineOffline(const qs::QuadricSlam& slam, std:
                          "batch refinement");
   *merges = solution.merges;
   std::printf("batch merged landmarks %d\n", s.merged_landmarks);
+  std::printf("batch unobserved landmarks %d (no keyframe observes them: left out of the map)\n",
+              s.unobserved_landmarks);
   // Pairs the batch's merge passes left (none once the passes converge).
   std::map<int, qs::QuadricLandmark> refined_by_id;
   for (const qs::QuadricLandmark& landmark : solution.landmarks)

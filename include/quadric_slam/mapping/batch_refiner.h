@@ -65,7 +65,8 @@ struct BatchStatistics {
   // is off), and the solves it took.
   double observation_variance_factor = 1.0;
   int solves = 0;
-  int merged_landmarks = 0;  // merged into another landmark (BatchSolution::merges)
+  int merged_landmarks = 0;      // merged into another landmark (BatchSolution::merges)
+  int unobserved_landmarks = 0;  // observed from no keyframe: left out of the refined map
   double solve_seconds = 0.0, covariance_seconds = 0.0;  // wall time
 };
 
@@ -73,9 +74,10 @@ struct BatchSolution {
   BatchStatistics statistics;
   std::vector<Eigen::Isometry3d> keyframe_poses;  // per recorded keyframe, refined
   std::vector<RefinedPose> trajectory;            // per recorded frame, re-attached
-  std::vector<QuadricLandmark> landmarks;  // the whole map (id order), refined estimates, merged
-                                           // landmarks removed
-  std::vector<LandmarkMerge> merges;       // the batch's merges, in their order
+  // The whole map (id order), refined estimates; merged landmarks removed, and (when the solution
+  // is usable) those that no keyframe observes, which the batch could neither refine nor check.
+  std::vector<QuadricLandmark> landmarks;
+  std::vector<LandmarkMerge> merges;  // the batch's merges, in their order
   // Pairs of refined landmarks still the same surface after the merge passes (tested with their
   // cross-covariances): none when the passes converged.
   std::vector<DuplicatePair> duplicates;

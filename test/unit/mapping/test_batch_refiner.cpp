@@ -12,6 +12,7 @@
 #include <iostream>
 #include <map>
 #include <random>
+#include <set>
 
 #include "map_report_checks.h"
 #include "quadric_slam/eval/map_metrics.h"
@@ -403,6 +404,44 @@ TEST(BatchRefiner, TwoTablesAtOneHeightStayTwo) {
             << merger.gate(QuadricClass::kPlane) << "), extents touch " << c.extents_touch << "\n";
   EXPECT_TRUE(c.within_gate) << "one plane";
   EXPECT_FALSE(c.extents_touch) << "two surfaces";
+}
+
+
+// A landmark of the map that no recorded keyframe observes (here one loaded into the mapper beside
+// the run's own, a copy of a run's landmark 3 m further along its normal under a new id) has no
+// block in the batch: the refined map leaves it out and counts it; every observed landmark stays.
+TEST(BatchRefiner, ALandmarkNoKeyframeObservesIsLeftOutOfTheRefinedMap) {
+  const std::vector<test::TrueLandmark> world = test::corridorWorld(12);
+  const std::vector<Eigen::Isometry3d> poses = test::corridorTrajectory(150);
+  QuadricMapper::Params params;
+  params.map.merging.enabled = false;
+  QuadricMapper online(params);
+  const RecordedRun run = runAndRecord(&online, world, poses, 7);
+  std::vector<QuadricLandmark> landmarks = online.landmarks();
+  ASSERT_FALSE(landmarks.empty());
+  QuadricLandmark unobserved = landmarks.front();
+  int max_id = 0;
+  for (const QuadricLandmark& l : landmarks)
+    max_id = std::max(max_id, l.id);
+  unobserved.id = max_id + 1;
+  Eigen::Isometry3d T = unobserved.quadric_map.pose();
+  T.translation() += 3.0 * T.linear().col(0);
+  unobserved.quadric_map =
+      QuadricModel(unobserved.quadric_map.quadricClass(), T, unobserved.quadric_map.scale(),
+                   unobserved.quadric_map.signature());
+  landmarks.push_back(unobserved);
+  QuadricMapper mapper;
+  mapper.loadLandmarks(landmarks, false);
+
+  const BatchSolution solution = BatchRefiner().refine(run.recorder, mapper);
+  ASSERT_TRUE(solution.statistics.solution_usable) << solution.statistics.report;
+  EXPECT_EQ(solution.statistics.unobserved_landmarks, 1);
+  EXPECT_EQ(solution.statistics.landmarks, static_cast<int>(landmarks.size()) - 1);
+  std::set<int> ids;
+  for (const QuadricLandmark& l : solution.landmarks)
+    ids.insert(l.id);
+  EXPECT_EQ(ids.count(unobserved.id), 0u);
+  EXPECT_EQ(solution.landmarks.size() + solution.merges.size(), landmarks.size() - 1);
 }
 
 }  // namespace
