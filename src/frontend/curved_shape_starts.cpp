@@ -8,7 +8,6 @@
 
 namespace quadric_slam {
 
-
 PrimitiveShape cylinderFromCone(const PrimitiveShape& cone,
                                 const std::vector<Eigen::Vector3d>& points) {
   const Eigen::Vector3d d = cone.direction;
@@ -24,8 +23,6 @@ PrimitiveShape cylinderFromCone(const PrimitiveShape& cone,
   }
   return PrimitiveShape::cylinder(on_axis, d, radius / points.size());
 }
-
-
 
 PrimitiveShape coneFromCylinder(const PrimitiveShape& cylinder,
                                 const std::vector<Eigen::Vector3d>& points) {
@@ -54,9 +51,27 @@ PrimitiveShape coneFromCylinder(const PrimitiveShape& cylinder,
   return cone;
 }
 
-
-
-
+PrimitiveShape coneFromTiltedCylinder(const PrimitiveShape& cylinder,
+                                      const std::vector<Eigen::Vector3d>& points, double tilt,
+                                      double sign) {
+  const Eigen::Vector3d& d = cylinder.direction;
+  // The mean direction from the axis to the points, normal to the axis.
+  Eigen::Vector3d towards = Eigen::Vector3d::Zero();
+  for (const auto& q : points) {
+    Eigen::Vector3d radial = q - cylinder.point;
+    radial -= d.dot(radial) * d;
+    const double norm = radial.norm();
+    if (norm > 0)
+      towards += radial / norm;
+  }
+  towards -= d.dot(towards) * d;
+  if (!(towards.norm() > 1e-9))
+    return PrimitiveShape::cone(cylinder.point, d, 0.0);
+  PrimitiveShape tilted = cylinder;
+  tilted.direction =
+      (std::cos(tilt) * d + sign * std::sin(tilt) * towards.normalized()).normalized();
+  return coneFromCylinder(tilted, points);
+}
 
 PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
                                const std::vector<Eigen::Vector3d>& normals) {
@@ -98,10 +113,6 @@ PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
   return cone;
 }
 
-
-
-
-
 PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
                                    const std::vector<Eigen::Vector3d>& normals, double curvature) {
   PrimitiveShape cylinder =
@@ -136,8 +147,6 @@ PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
   }
   return cylinder;
 }
-
-
 
 double shapeCurvature(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
   if (shape.quadric_class != QuadricClass::kCone)

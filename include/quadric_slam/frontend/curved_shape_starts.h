@@ -1,7 +1,7 @@
 // Starting shapes for the refinement of curved primitives, from points (and their normals): a
-// cylinder from a thin cone, a cone from a cylinder fit, a cone or a cylinder from the normals alone;
-// and a shape's own curvature over its support, which the segmenter compares with the measured
-// normals' bending.
+// cylinder from a thin cone, a cone from a cylinder fit, a cone or a cylinder from the normals
+// alone; and a shape's own curvature over its support, which the segmenter compares with the
+// measured normals' bending.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,6 +19,16 @@ PrimitiveShape cylinderFromCone(const PrimitiveShape& cone,
 // coordinate, rho = r0 + k z; none (half angle 0) when k vanishes.
 PrimitiveShape coneFromCylinder(const PrimitiveShape& cylinder,
                                 const std::vector<Eigen::Vector3d>& points);
+
+// The cone through the points of a cylinder fit whose axis is first tilted by `tilt` (rad) towards
+// (sign +1) or away from (sign -1) the points, about the axis normal to both (coneFromCylinder on
+// the tilted axis). A cylinder fitted to the visible side of a cone lies along the generator on
+// that side, its axis tilted by about the half angle from the cone's: along the cylinder's own
+// axis the radius does not change and the regression gives a thin cone that the refinement does
+// not leave; along the tilted axis the radius grows and the cone's opening is found.
+PrimitiveShape coneFromTiltedCylinder(const PrimitiveShape& cylinder,
+                                      const std::vector<Eigen::Vector3d>& points, double tilt,
+                                      double sign);
 
 // A cone from points and their normals: every tangent plane passes through the apex
 // (n_i . (apex - p_i) = 0, linear least squares), and the normals lie on a small circle around

@@ -8,6 +8,7 @@
 
 #include "axial_surface_samples.h"
 #include "quadric_slam/frontend/curved_shape_starts.h"
+#include "quadric_slam/frontend/shape_refiner.h"
 
 namespace qs = quadric_slam;
 using qs::PrimitiveShape;
@@ -75,15 +76,44 @@ TEST(CurvedShapeStarts, ConeFromCylinderAndCylinderFromConeRoundTheAxis) {
 
 TEST(CurvedShapeStarts, ShapeCurvatureIsOneOverRadiusOrTheConesMeanCurvature) {
   const std::vector<Eigen::Vector3d> none;
+  EXPECT_DOUBLE_EQ(qs::shapeCurvature(PrimitiveShape::sphere(Eigen::Vector3d(0, 0, 2), 0.25), none),
+                   4.0);
   EXPECT_DOUBLE_EQ(
-      qs::shapeCurvature(PrimitiveShape::sphere(Eigen::Vector3d(0, 0, 2), 0.25), none), 4.0);
-  EXPECT_DOUBLE_EQ(qs::shapeCurvature(PrimitiveShape::cylinder(Eigen::Vector3d(0, 0, 2),
-                                                               Eigen::Vector3d::UnitY(), 0.05),
-                                      none),
-                   20.0);
+      qs::shapeCurvature(
+          PrimitiveShape::cylinder(Eigen::Vector3d(0, 0, 2), Eigen::Vector3d::UnitY(), 0.05), none),
+      20.0);
   // A cone point at distance rho from the axis: curvature cos(half angle) / rho.
   const PrimitiveShape cone =
       PrimitiveShape::cone(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(), 0.4);
   const std::vector<Eigen::Vector3d> at_rho = {Eigen::Vector3d(0.1, 0.5, 0)};
   EXPECT_NEAR(qs::shapeCurvature(cone, at_rho), std::cos(0.4) / 0.1, 1e-12);
+}
+
+// A cylinder fitted to the visible side of a cone tilts its axis to follow the near generator:
+// along that axis the radius hardly changes and coneFromCylinder gives a thin cone; with the axis
+// tilted the right way the regression sees the opening and the refinement reaches the cone.
+TEST(CurvedShapeStarts, ConeFromTiltedCylinderFindsTheOpeningACylinderFitHides) {
+  const double half_angle = 0.32;
+  const Samples s = axialSurface(true, half_angle, 0.2, 0.6, 0.002, 5);
+  const qs::ShapeRefiner refiner;
+  const qs::ShapeRefiner::Result cylinder = refiner.refine(
+      qs::cylinderFromCone(qs::coneFromNormals(s.points, s.normals), s.points), s.points);
+  ASSERT_TRUE(cylinder.ok);
+  ASSERT_EQ(cylinder.shape.quadric_class, qs::QuadricClass::kCylinder);
+  EXPECT_GT(angleBetweenAxes(cylinder.shape.direction, Eigen::Vector3d::UnitY()), 0.15)
+      << "the fitted cylinder follows the near generator";
+  EXPECT_LT(qs::coneFromCylinder(cylinder.shape, s.points).size, 0.1);
+  double best_rms = 1e9, best_half_angle = 0, best_axis_error = 1;
+  for (double sign : {1.0, -1.0}) {
+    const qs::ShapeRefiner::Result cone =
+        refiner.refine(qs::coneFromTiltedCylinder(cylinder.shape, s.points, 0.3, sign), s.points);
+    if (cone.ok && cone.rms < best_rms) {
+      best_rms = cone.rms;
+      best_half_angle = cone.shape.size;
+      best_axis_error = angleBetweenAxes(cone.shape.direction, Eigen::Vector3d::UnitY());
+    }
+  }
+  EXPECT_NEAR(best_half_angle, half_angle, 0.02);
+  EXPECT_LT(best_axis_error, 0.02);
+  EXPECT_LT(best_rms, 0.8 * cylinder.rms);
 }
