@@ -152,10 +152,7 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
       if (!best_cone || as_cone->rms < best_cone->rms)
         best_cone = as_cone;
     }
-    // The cone must also follow the measured normals at least as well: a cone tilted against a
-    // cylinder by its half angle hugs the visible side as closely as the cylinder does (and over
-    // many points may fit a little better), but its normals turn across the visible arc where the
-    // measured ones do not.
+    // Whatever its start, no cone whose normals agree worse than the cylinder's (see above).
     if (best_cone && alternatives.normalDisagreement(best_cone->shape) >
                          alternatives.normalDisagreement(fit.shape))
       best_cone.reset();

@@ -1,7 +1,9 @@
 // Model selection among the curved classes for one supported surface patch: given the refined fit
 // of the patch's current class, try the other classes from starts built on the same points and
 // keep a simpler class that fits almost as well (a thin cone is a cylinder; a wide cone or a
-// cylinder on a sphere cap is a sphere), or a cone that fits clearly better than a cylinder.
+// cylinder on a sphere cap is a sphere), or a cone that fits clearly better than a cylinder and
+// whose normals agree with the measured ones at least as well (clearly better for a cone started
+// from the cylinder's axis tilted, which may lean against a cylinder by its half angle).
 //
 // The alternatives are screened on an even sub-sample of the support (kScreeningPoints): most of
 // them are the wrong model (a sphere on a cylinder patch), and Levenberg-Marquardt on a wrong model
@@ -23,7 +25,8 @@ namespace quadric_slam {
 constexpr int kScreeningPoints = 250;
 
 // The best of fit (refined on points, class sphere, cylinder or cone) and the alternatives;
-// normals are the measured unit normals of the points (the cone start from normals uses them).
+// normals are the measured unit normals of the points (the cone start from normals and the
+// cones' normal agreement use them).
 // Planes and general quadrics are returned unchanged.
 ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& fit,
                                        const std::vector<Eigen::Vector3d>& points,
