@@ -6,6 +6,8 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
+#include <sstream>
+#include <string>
 
 #include "quadric_slam/frontend/primitive_shape.h"
 #include "quadric_slam/frontend/shape_refiner.h"
@@ -227,6 +229,34 @@ TEST(PrimitiveShape, PerturbThrowsWhenTheScaleStepLeavesTheClass) {
   EXPECT_THROW(perturb(sphere, sphere_step), std::invalid_argument);
 }
 
+namespace {
+
+// distanceJacobian(s, points) against central differences of the distances through perturb, per
+// point and minimal coordinate (what names the shape in the failure messages).
+void expectDistanceJacobianMatchesCentralDifferences(const PrimitiveShape& s,
+                                                     const std::vector<Eigen::Vector3d>& points,
+                                                     const std::string& what) {
+  const int k = qs::minimalDimension(s.quadric_class);
+  const Eigen::MatrixXd J = qs::distanceJacobian(s, points);
+  ASSERT_EQ(J.rows(), static_cast<Eigen::Index>(points.size()));
+  ASSERT_EQ(J.cols(), k);
+  constexpr double h = 1e-6;
+  for (int j = 0; j < k; ++j) {
+    Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
+    delta[j] = h;
+    const PrimitiveShape plus = qs::perturb(s, delta);
+    delta[j] = -h;
+    const PrimitiveShape minus = qs::perturb(s, delta);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const double numeric = (plus.distance(points[i]) - minus.distance(points[i])) / (2 * h);
+      EXPECT_NEAR(J(static_cast<Eigen::Index>(i), j), numeric, 1e-6 * (1 + std::abs(numeric)))
+          << what << " point " << i << " coordinate " << j;
+    }
+  }
+}
+
+}  // namespace
+
 // The refiner's analytic Jacobian (per-point gradient chained through perturb) against central
 // differences of the distances through perturb, for every class at points on, in front of and
 // behind the surface; and distanceGradient itself against differences in (point, direction, size).
@@ -237,24 +267,9 @@ TEST(ShapeRefiner, AnalyticDistanceJacobianMatchesNumericDifferentiation) {
     std::vector<Eigen::Vector3d> points = surfaceSamples(s, 60, 3);
     for (Eigen::Vector3d& p : points)
       p += off_surface(rng) * s.normalAt(p);
-    const int k = qs::minimalDimension(s.quadric_class);
-    const Eigen::MatrixXd J = qs::distanceJacobian(s, points);
-    ASSERT_EQ(J.rows(), static_cast<Eigen::Index>(points.size()));
-    ASSERT_EQ(J.cols(), k);
-    constexpr double h = 1e-6;
-    for (int j = 0; j < k; ++j) {
-      Eigen::VectorXd delta = Eigen::VectorXd::Zero(k);
-      delta[j] = h;
-      const PrimitiveShape plus = qs::perturb(s, delta);
-      delta[j] = -h;
-      const PrimitiveShape minus = qs::perturb(s, delta);
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        const double numeric = (plus.distance(points[i]) - minus.distance(points[i])) / (2 * h);
-        EXPECT_NEAR(J(static_cast<Eigen::Index>(i), j), numeric, 1e-6 * (1 + std::abs(numeric)))
-            << qs::toString(s.quadric_class) << " point " << i << " coordinate " << j;
-      }
-    }
+    expectDistanceJacobianMatchesCentralDifferences(s, points, qs::toString(s.quadric_class));
     // distanceGradient in the shape's own parameters.
+    constexpr double h = 1e-6;
     const Eigen::Vector3d probe = points[7];
     const Eigen::Matrix<double, 7, 1> g = s.distanceGradient(probe);
     for (int j = 0; j < 7; ++j) {
@@ -294,21 +309,8 @@ TEST(ShapeRefiner, GeneralQuadricDistanceJacobianMatchesNumericDifferentiation) 
     std::vector<Eigen::Vector3d> points;
     for (int i = 0; i < 80; ++i)
       points.push_back(T * Eigen::Vector3d(uni(rng), uni(rng), uni(rng)));
-    const Eigen::MatrixXd J = qs::distanceJacobian(s, points);
-    ASSERT_EQ(J.cols(), 9);
-    constexpr double h = 1e-6;
-    for (int j = 0; j < 9; ++j) {
-      Eigen::VectorXd delta = Eigen::VectorXd::Zero(9);
-      delta[j] = h;
-      const PrimitiveShape plus = qs::perturb(s, delta);
-      delta[j] = -h;
-      const PrimitiveShape minus = qs::perturb(s, delta);
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        const double numeric = (plus.distance(points[i]) - minus.distance(points[i])) / (2 * h);
-        EXPECT_NEAR(J(static_cast<Eigen::Index>(i), j), numeric, 1e-6 * (1 + std::abs(numeric)))
-            << "signature " << s.general_quadric.signature().transpose() << " point " << i
-            << " coordinate " << j;
-      }
-    }
+    std::ostringstream what;
+    what << "general, signature " << s.general_quadric.signature().transpose();
+    expectDistanceJacobianMatchesCentralDifferences(s, points, what.str());
   }
 }
