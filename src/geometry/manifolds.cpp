@@ -1,5 +1,7 @@
 #include "quadric_slam/geometry/manifolds.h"
 
+#include <algorithm>
+
 #include "quadric_slam/geometry/quadric_classes.h"
 #include "quadric_slam/geometry/se3.h"
 
@@ -53,9 +55,9 @@ void quadricToParameters(const QuadricModel& quadric, double* p) {
 }
 
 QuadricModel quadricFromParameters(const double* p, QuadricClass quadric_class,
-                              const Eigen::Vector4d& signature) {
+                                   const Eigen::Vector4d& signature) {
   return QuadricModel(quadric_class, poseFromParameters(p), Eigen::Vector3d(p[7], p[8], p[9]),
-                 signature);
+                      signature);
 }
 
 Eigen::Matrix<double, 7, 6> posePlusJacobian(const double* x) {
@@ -124,8 +126,14 @@ bool QuadricManifold::Plus(const double* x, const double* delta, double* x_plus_
   const Eigen::Map<const Eigen::VectorXd> d(delta, basis_.cols());
   const Vector9d general = basis_ * d;
   posePlus(x, general.data(), x_plus_delta);
+  // S lives in D^3, the positive diagonal matrices: as QuadricModel::plus, a step that would take a
+  // scale through zero stops at kMinScaleStepFraction of it. The map is continuous and the
+  // identity near the optimum (the Jacobians at delta = 0 are unchanged); refusing the step
+  // instead (returning false) makes Ceres end the whole solve when its projected-gradient test,
+  // Plus(x, -gradient), fails.
   for (int i = 0; i < 3; ++i)
-    x_plus_delta[7 + i] = x[7 + i] + general[6 + i];
+    x_plus_delta[7 + i] =
+        std::max(x[7 + i] + general[6 + i], QuadricModel::kMinScaleStepFraction * x[7 + i]);
   return true;
 }
 

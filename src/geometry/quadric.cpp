@@ -33,11 +33,11 @@ void checkScaleTies(QuadricClass c, const Eigen::Vector3d& scale, double tol) {
 QuadricModel::QuadricModel() = default;
 
 QuadricModel::QuadricModel(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
-                 const Eigen::Vector3d& scale)
+                           const Eigen::Vector3d& scale)
     : QuadricModel(quadric_class, T_frame_quadric, scale, defaultSignature(quadric_class)) {}
 
 QuadricModel::QuadricModel(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
-                 const Eigen::Vector3d& scale, const Eigen::Vector4d& signature)
+                           const Eigen::Vector3d& scale, const Eigen::Vector4d& signature)
     : class_(quadric_class),
       T_frame_quadric_(T_frame_quadric),
       scale_(scale),
@@ -76,7 +76,7 @@ Eigen::Matrix4d QuadricModel::matrix() const {
 }
 
 QuadricModel QuadricModel::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass quadric_class,
-                            double relative_tolerance) {
+                                      double relative_tolerance) {
   classDefinition(quadric_class);
   if (!Q_in.allFinite())
     throw std::invalid_argument("QuadricModel::fromMatrix: Q is not finite");
@@ -167,7 +167,8 @@ QuadricModel QuadricModel::fromMatrix(const Eigen::Matrix4d& Q_in, QuadricClass 
   if (overall < 0)
     std::swap(pos, neg);
   if (neg == 0 && k > 0)
-    throw std::invalid_argument("QuadricModel::fromMatrix: Q has no real points (imaginary quadric)");
+    throw std::invalid_argument(
+        "QuadricModel::fromMatrix: Q has no real points (imaginary quadric)");
   if (neg == 0 && k == 0)
     throw std::invalid_argument("QuadricModel::fromMatrix: degenerate Q (a single point)");
 
@@ -216,7 +217,7 @@ QuadricModel QuadricModel::transformed(const Eigen::Isometry3d& T_A_frame) const
 QuadricModel QuadricModel::plus(const Vector9d& delta) const {
   QuadricModel out = *this;
   out.T_frame_quadric_ = quadric_slam::plus(T_frame_quadric_, delta.head<6>());
-  out.scale_ = scale_ + delta.tail<3>();
+  out.scale_ = (scale_ + delta.tail<3>()).cwiseMax(kMinScaleStepFraction * scale_);
   return out;
 }
 
@@ -242,7 +243,8 @@ Eigen::VectorXd QuadricModel::minusMinimal(const QuadricModel& other) const {
 }
 
 // eq. 19
-QuadricModel predictMeasurement(const Eigen::Isometry3d& T_world_camera, const QuadricModel& quadric_world) {
+QuadricModel predictMeasurement(const Eigen::Isometry3d& T_world_camera,
+                                const QuadricModel& quadric_world) {
   return quadric_world.transformed(T_world_camera.inverse());
 }
 

@@ -187,6 +187,8 @@ class OdometryNodelet : public nodelet::Nodelet {
     last_stamp_ = stamp;
 
     // (What the tracker throws is caught by the guard around this callback and counted as a drop.)
+    if (observations != nullptr)
+      tracker_->adoptSurfaceNormals(*observations, cloud_);
     const OdometryTracker::Result result = tracker_->track(cloud_, intrinsics, stamp, observations);
     if (result.status != TrackingStatus::kOk) {
       NODELET_WARN_THROTTLE(5.0, "odometry: tracking %s: %s", toString(result.status),

@@ -52,6 +52,12 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "guess_min_translation", params.guess_min_translation, log);
   readParam(reader, "guess_skip_inlier_fraction", params.guess_skip_inlier_fraction, log);
   readParam(reader, "guess_min_rotation", params.guess_min_rotation, log);
+  SurfaceNormalParams& surface_normals = params.surface_normals;
+  readParam(reader, "surface_normals", surface_normals.enabled, log);
+  readParam(reader, "surface_normal_max_distance_rms", surface_normals.max_distance_rms, log);
+  readParam(reader, "surface_normal_min_max_distance", surface_normals.min_max_distance, log);
+  readParam(reader, "surface_normal_max_angle", surface_normals.max_angle, log);
+  readParam(reader, "surface_normal_min_depth", surface_normals.min_depth, log);
   QuadricMotionGuesser::Params& guess = params.guess;
   readParam(reader, "guess_max_angle_difference", guess.max_angle_difference, log);
   readParam(reader, "guess_max_offset_difference", guess.max_offset_difference, log);

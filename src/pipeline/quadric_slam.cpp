@@ -184,9 +184,11 @@ SlamFrameResult QuadricSlam::backEnd(FrontEndFrame* front) {
   out.measurements = std::move(front->measurements);
   const CameraIntrinsics& k = front->intrinsics;
 
-  // The segmentation's surfaces give the odometry a motion guess for large steps.
+  // The segmentation's surfaces give the odometry its normals and a motion guess for large steps.
   const bool tracker_was_initialized = odometry_.initialized();
   out.odometry = timeStage(timer_, "odometry", &out.odometry_ms, [&] {
+    if (params_.mapping_enabled)
+      odometry_.adoptSurfaceNormals(out.measurements.observations, cloud_);
     return odometry_.track(cloud_, k, front->stamp,
                            params_.mapping_enabled ? &out.measurements.observations : nullptr);
   });

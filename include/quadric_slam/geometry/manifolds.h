@@ -8,7 +8,8 @@
 // Tangent spaces: pose [rho; phi] (6) applied in the body frame, x [+] xi = x exp(xi^) (se3.h);
 // quadric: the class's minimal vector (Table II, k = 3..9), mapped into [rho; phi; s] by the
 // class's B (quadric_classes.h): x [+] d = (T exp((B d)_pose^), S + D((B d)_scale)) (eqs. 9-17),
-// Minus(y, x) = B^+ [log(T_x^-1 T_y)^vee; s_y - s_x].
+// Minus(y, x) = B^+ [log(T_x^-1 T_y)^vee; s_y - s_x]. The quadric Plus keeps S positive: a step
+// that would take a scale below a thousandth of its value stops there.
 #pragma once
 
 #include <ceres/manifold.h>
@@ -30,7 +31,7 @@ Eigen::Isometry3d poseFromParameters(const double* parameters);
 void quadricToParameters(const QuadricModel& quadric, double* parameters);
 // Throws std::invalid_argument (from QuadricModel) when the block holds an invalid quadric.
 QuadricModel quadricFromParameters(const double* parameters, QuadricClass quadric_class,
-                              const Eigen::Vector4d& signature);
+                                   const Eigen::Vector4d& signature);
 
 // d(ambient)/d(tangent) of the pose Plus at delta = 0 (7 x 6) and a left inverse of it, the
 // Minus Jacobian at y = x (6 x 7); (Minus * Plus = I).

@@ -29,9 +29,9 @@ class QuadricModel {
   // For the classes of revolution the scale must obey the class's ties (sphere alpha=beta=gamma,
   // cylinder/cone alpha=beta with gamma=1, plane (1,1,1)) to relative 1e-6.
   QuadricModel(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
-          const Eigen::Vector3d& scale);
+               const Eigen::Vector3d& scale);
   QuadricModel(QuadricClass quadric_class, const Eigen::Isometry3d& T_frame_quadric,
-          const Eigen::Vector3d& scale, const Eigen::Vector4d& signature);
+               const Eigen::Vector3d& scale, const Eigen::Vector4d& signature);
 
   QuadricClass quadricClass() const { return class_; }
   // T_frame_quadric: maps canonical-quadric-frame points into the frame the quadric lives in.
@@ -54,15 +54,20 @@ class QuadricModel {
   // paraboloids and parabolic cylinders (not supported), or when the result is not of the requested
   // class (e.g. unequal scales for kSphere) to within relative_tolerance.
   static QuadricModel fromMatrix(const Eigen::Matrix4d& Q, QuadricClass quadric_class,
-                            double relative_tolerance = 1e-6);
+                                 double relative_tolerance = 1e-6);
 
   // This quadric expressed in frame A, given T_A_frame (the quadric currently lives in `frame`).
   QuadricModel transformed(const Eigen::Isometry3d& T_A_frame) const;
 
   // pi [+] delta = (T exp(xi^), S + D(s)) with delta = [rho; phi; s] (eqs. 9, 11, 16; body frame).
-  // The class is kept; the caller keeps delta within the class (see plusMinimal).
+  // The class is kept; the caller keeps delta within the class (see plusMinimal). S stays in D^3
+  // (positive): a step that would take a scale below kMinScaleStepFraction of its value stops
+  // there (an information-weighted fusion of two cone estimates once asked for a radius of
+  // -0.06 m).
   QuadricModel plus(const Vector9d& delta) const;
-  // pi [-] pi' = [log(T'^-1 T)^vee; D^-1(S - S')] (eqs. 10, 14, 17). Exact inverse of plus().
+  static constexpr double kMinScaleStepFraction = 1e-3;
+  // pi [-] pi' = [log(T'^-1 T)^vee; D^-1(S - S')] (eqs. 10, 14, 17). Exact inverse of plus() where
+  // plus() leaves the scales above that bound.
   Vector9d minus(const QuadricModel& other) const;
   // The same through the class's minimal vector (Table II): plus(B delta), B^+ minus(other).
   QuadricModel plusMinimal(const Eigen::VectorXd& delta) const;
@@ -77,6 +82,7 @@ class QuadricModel {
 
 // The measurement prediction h(T_WC, pi) = (T_WC^-1 T_WQ, S) (eq. 19): the quadric in the camera
 // frame.
-QuadricModel predictMeasurement(const Eigen::Isometry3d& T_world_camera, const QuadricModel& quadric_world);
+QuadricModel predictMeasurement(const Eigen::Isometry3d& T_world_camera,
+                                const QuadricModel& quadric_world);
 
 }  // namespace quadric_slam

@@ -10,6 +10,7 @@
 
 #include "quadric_slam/odometry/point_to_plane_icp.h"
 #include "quadric_slam/odometry/quadric_motion_guess.h"
+#include "quadric_slam/odometry/surface_normals.h"
 #include "quadric_slam/types/camera_intrinsics.h"
 #include "quadric_slam/types/observation.h"
 
@@ -50,6 +51,10 @@ class OdometryTracker {
     // guess and its extra ICP cost time on every frame.
     double guess_skip_inlier_fraction = 0.9;
     QuadricMotionGuesser::Params guess;
+    // The ICP's normals from the frame's fitted surfaces (odometry/surface_normals.h): track()
+    // does not change its cloud, so the caller calls adoptSurfaceNormals() before it (QuadricSlam
+    // and the odometry nodelet do).
+    SurfaceNormalParams surface_normals;
     // No runaway: when the constant-velocity prediction is more than guess_min_translation or
     // guess_min_rotation from the last pose, ICP also starts from the last pose (zero motion) and
     // the better alignment is kept, so a velocity the data do not confirm cannot carry the
@@ -123,6 +128,12 @@ class OdometryTracker {
   // tracks from the constant-velocity prior alone.
   Result track(const Cloud& cloud, const CameraIntrinsics& intrinsics, double stamp,
                const std::vector<QuadricMeasurement>* observations = nullptr);
+
+  // Gives the points of cloud that lie on the frame's observed surfaces the surfaces' normals
+  // (Params::surface_normals; odometry/surface_normals.h), on the grid the ICP reads (every
+  // gcd(reference_stride, finest_stride)-th point). Call it before track() with the same
+  // observations. Returns the number of normals replaced.
+  int adoptSurfaceNormals(const std::vector<QuadricMeasurement>& observations, Cloud& cloud) const;
 
   // Forgets the keyframe, pose and velocity: the next usable frame starts a new odom frame.
   void reset();

@@ -46,6 +46,12 @@ void expectManifoldConsistent(const ceres::Manifold& m, const Eigen::VectorXd& x
       d[i] = test::uniform(rng, -0.8, 0.8);
     Eigen::VectorXd y(n), back(k);
     m.Plus(x.data(), d.data(), y.data());
+    // The round trip holds on the manifold: a quadric step must leave its scales positive (the
+    // quadric Plus stops a scale at a thousandth of its value), so shorter steps until it does.
+    while (n == kQuadricParameterSize && (y.tail<3>().array() < 0.5 * x.tail<3>().array()).any()) {
+      d *= 0.5;
+      m.Plus(x.data(), d.data(), y.data());
+    }
     m.Minus(y.data(), x.data(), back.data());
     EXPECT_LT((back - d).norm(), 1e-10);
   }
@@ -109,6 +115,28 @@ TEST(QuadricManifold, TangentMovesFollowTableTwo) {
   const Eigen::Vector3d shift =
       plane.plusMinimal(dp).pose().translation() - plane.pose().translation();
   EXPECT_LT((shift - 0.3 * plane.pose().linear().col(0)).norm(), 1e-12);
+}
+
+TEST(QuadricManifold, AStepCannotTakeARadiusThroughZero) {
+  // A cylinder of radius 0.05 m: its tangent (rho1, rho2, phi1, phi2, alpha) with alpha the
+  // radius' step. S must stay in D^3 (positive): a step through zero stops at a thousandth of the
+  // radius, and Plus still succeeds (Ceres ends a solve whose projected-gradient step fails).
+  const QuadricManifold manifold(QuadricClass::kCylinder);
+  Eigen::VectorXd x(kQuadricParameterSize);
+  x << 0.1, -0.2, 1.5, 0, 0, 0, 1, 0.05, 0.05, 1;
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(5), out(kQuadricParameterSize);
+  d[4] = 0.03;
+  EXPECT_TRUE(manifold.Plus(x.data(), d.data(), out.data()));
+  EXPECT_NEAR(out[7], 0.08, 1e-12);
+  for (const double step : {-0.05, -0.07, -3.0}) {
+    d[4] = step;
+    EXPECT_TRUE(manifold.Plus(x.data(), d.data(), out.data()));
+    EXPECT_NEAR(out[7], 0.05e-3, 1e-15) << step;
+    EXPECT_EQ(out[8], out[7]);
+    EXPECT_EQ(out[9], 1.0);  // the cylinder's axis scale does not move
+    EXPECT_NO_THROW(
+        quadricFromParameters(out.data(), QuadricClass::kCylinder, Eigen::Vector4d(1, 1, 0, -1)));
+  }
 }
 
 }  // namespace

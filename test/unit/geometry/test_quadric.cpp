@@ -92,8 +92,8 @@ TEST(GeneralQuadric, DecomposeRoundTripHyperbolicCylinder) {
 
 TEST(QuadricModel, ComposeFollowsEquationFive) {
   // Paper, Table I row 2: T = I, S = diag(1, 0.5, 2), ellipsoid x^2 + y^2/4 + 4 z^2 = 1.
-  const QuadricModel q(QuadricClass::kGeneral, Eigen::Isometry3d::Identity(), Eigen::Vector3d(1, 0.5, 2),
-                  Eigen::Vector4d(1, 1, 1, -1));
+  const QuadricModel q(QuadricClass::kGeneral, Eigen::Isometry3d::Identity(),
+                       Eigen::Vector3d(1, 0.5, 2), Eigen::Vector4d(1, 1, 1, -1));
   EXPECT_LT((q.matrix() - Eigen::Vector4d(1, 0.25, 4, -1).asDiagonal().toDenseMatrix()).norm(),
             1e-15);
   EXPECT_NEAR(algebraicDistance(q, Eigen::Vector3d(0, 2, 0)), 0, 1e-15);
@@ -102,7 +102,7 @@ TEST(QuadricModel, ComposeFollowsEquationFive) {
   Eigen::Matrix3d R;
   R << 0, 1, 0, 0, 0, 1, 1, 0, 0;  // quadric x -> world z
   const QuadricModel plane(QuadricClass::kPlane, makeIsometry(R, Eigen::Vector3d(1, 2, 3)),
-                      Eigen::Vector3d::Ones());
+                           Eigen::Vector3d::Ones());
   EXPECT_NEAR(algebraicDistance(plane, Eigen::Vector3d(-5, 7, 3)), 0, 1e-12);
   EXPECT_NEAR(algebraicDistance(plane, Eigen::Vector3d(-5, 7, 4)), 1, 1e-12);  // (alpha x)^2
 }
@@ -113,7 +113,7 @@ TEST(QuadricModel, PaperTableOneRowThree) {
   Eigen::Matrix4d T;
   T << 1, 0, 0, 0, 0, 0, 1, 3, 0, -1, 0, 0, 0, 0, 0, 1;
   const QuadricModel q(QuadricClass::kGeneral, Eigen::Isometry3d(T), Eigen::Vector3d(1, 0.5, 2),
-                  Eigen::Vector4d(1, 1, 1, -1));
+                       Eigen::Vector4d(1, 1, 1, -1));
   for (const Eigen::Vector3d& p : {Eigen::Vector3d(1, 3, 0), Eigen::Vector3d(0, 3, -2),
                                    Eigen::Vector3d(0, 3, 2), Eigen::Vector3d(0, 3.5, 0)}) {
     const Eigen::Vector4d ph(p.x(), p.y(), p.z(), 1);
@@ -145,8 +145,8 @@ TEST(QuadricModel, PlusMinusRoundTrip) {
       Vector9d d;
       for (int i = 0; i < 9; ++i)
         d[i] = test::uniform(rng, -0.5, 0.5);
-      const QuadricModel general =
-          QuadricModel(QuadricClass::kGeneral, q.pose(), q.scale() * 2.0, Eigen::Vector4d(1, 1, 1, -1));
+      const QuadricModel general = QuadricModel(QuadricClass::kGeneral, q.pose(), q.scale() * 2.0,
+                                                Eigen::Vector4d(1, 1, 1, -1));
       EXPECT_LT((general.plus(d).minus(general) - d).norm(), 1e-10);  // eqs. 10-17
       const int k = minimalDimension(c);
       Eigen::VectorXd m(k);
@@ -192,7 +192,8 @@ TEST(QuadricModel, DecomposeRejectsDegenerateAndUnsupported) {
 
 TEST(QuadricModel, ConstructorValidates) {
   const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
-  EXPECT_THROW(QuadricModel(QuadricClass::kSphere, I, Eigen::Vector3d(1, 2, 1)), std::invalid_argument);
+  EXPECT_THROW(QuadricModel(QuadricClass::kSphere, I, Eigen::Vector3d(1, 2, 1)),
+               std::invalid_argument);
   EXPECT_THROW(QuadricModel(QuadricClass::kCylinder, I, Eigen::Vector3d(2, 2, 3)),
                std::invalid_argument);
   EXPECT_THROW(QuadricModel(QuadricClass::kSphere, I, Eigen::Vector3d(-1, -1, -1)),
@@ -200,10 +201,28 @@ TEST(QuadricModel, ConstructorValidates) {
   EXPECT_THROW(
       QuadricModel(QuadricClass::kCone, I, Eigen::Vector3d(1, 1, 1), Eigen::Vector4d(1, 1, 1, -1)),
       std::invalid_argument);
-  EXPECT_THROW(
-      QuadricModel(QuadricClass::kGeneral, I, Eigen::Vector3d(1, 1, 1), Eigen::Vector4d(1, 0.5, 1, -1)),
-      std::invalid_argument);
+  EXPECT_THROW(QuadricModel(QuadricClass::kGeneral, I, Eigen::Vector3d(1, 1, 1),
+                            Eigen::Vector4d(1, 0.5, 1, -1)),
+               std::invalid_argument);
   EXPECT_NO_THROW(QuadricModel(QuadricClass::kCylinder, I, Eigen::Vector3d(2, 2, 1)));
+}
+
+TEST(QuadricPlus, AScaleStepThroughZeroStopsAboveZero) {
+  // A cone of opening 0.06: a fused estimate once asked it for -0.06. S stays in D^3, so the
+  // result is still a cone, and every check of the class (the constructor's) holds.
+  const QuadricModel cone(QuadricClass::kCone, Eigen::Isometry3d::Identity(),
+                          Eigen::Vector3d(0.06, 0.06, 1.0));
+  Vector9d delta = Vector9d::Zero();
+  delta.tail<3>() << -0.12, -0.12, 0.0;
+  const QuadricModel stepped = cone.plus(delta);
+  EXPECT_NEAR(stepped.scale().x(), 0.06 * QuadricModel::kMinScaleStepFraction, 1e-15);
+  EXPECT_EQ(stepped.scale().y(), stepped.scale().x());
+  EXPECT_EQ(stepped.scale().z(), 1.0);
+  EXPECT_NO_THROW(
+      QuadricModel(stepped.quadricClass(), stepped.pose(), stepped.scale(), stepped.signature()));
+  // Inside D^3 the step is the sum, and minus() undoes it.
+  delta.tail<3>() << -0.02, -0.02, 0.0;
+  EXPECT_LT((cone.plus(delta).minus(cone) - delta).norm(), 1e-15);
 }
 
 }  // namespace

@@ -77,6 +77,7 @@ TEST(TrackingFarWalls, AVelocityTheDataDoNotConfirmIsNotCarriedOn) {
     observations.push_back(
         toFrameMeasurements(segmenter.segment(clouds.back()), frame.stamp, frame.frame_id)
             .observations);
+    OdometryTracker(params.odometry).adoptSurfaceNormals(observations.back(), clouds.back());
     truth.push_back(source.groundTruth()[k].T_world_sensor);
     intrinsics = frame.intrinsics;
   }

@@ -121,6 +121,7 @@ inline TrackingRun runTracker(FrameSource& source, const Trajectory& truth,
         backProject(depthViewOf(frame.depth_m), frame.intrinsics, params.back_projection), cloud);
     const FrameMeasurements measurements =
         toFrameMeasurements(segmenter.segment(cloud), frame.stamp, frame.frame_id);
+    tracker.adoptSurfaceNormals(measurements.observations, cloud);  // as QuadricSlam does
     const OdometryTracker::Result result =
         tracker.track(cloud, frame.intrinsics, frame.stamp, &measurements.observations);
     TrackedFrame f;
