@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "quadric_slam/geometry/quadric_classes.h"
 #include "quadric_slam/geometry/shapes.h"
 #include "quadric_slam/geometry/surface_distance.h"
 
@@ -256,14 +257,16 @@ PrimitiveShape perturb(const PrimitiveShape& shape, const Eigen::VectorXd& delta
     throw std::invalid_argument("perturb: delta has the wrong dimension for the class");
   }
   // pi [+] dpi = (T exp(xi), S + D(s)) in the quadric frame (eqs. 9, 11, 16; Table II basis).
-  const QuadricModel moved = shape.quadric().plusMinimal(delta);
-  // The core's [+] adds the scale step unchecked: a step through alpha = 0 leaves a quadric with a
-  // scale <= 0 (which QuadricModel's constructor rejects), read back as a negative radius or a
-  // cone half angle beyond pi/2, a shape whose distance() is another surface.
-  if (!(moved.scale().minCoeff() > 0) || !moved.scale().allFinite())
+  const QuadricModel quadric = shape.quadric();
+  // A step through alpha = 0 leaves the class (a negative radius, a cone half angle beyond pi/2):
+  // the core's [+] would stop it at a thousandth of the scale (a radius a thousand times larger,
+  // another surface), so the refiner's guarded step is told here instead.
+  const Eigen::Vector3d scale =
+      quadric.scale() + (classDefinition(shape.quadric_class).basis * delta).tail<3>();
+  if (!(scale.minCoeff() > 0) || !scale.allFinite())
     throw std::invalid_argument("perturb: the step leaves the class (scale " +
-                                std::to_string(moved.scale().minCoeff()) + " <= 0)");
-  return PrimitiveShape::fromQuadric(moved);
+                                std::to_string(scale.minCoeff()) + " <= 0)");
+  return PrimitiveShape::fromQuadric(quadric.plusMinimal(delta));
 }
 
 }  // namespace quadric_slam

@@ -150,13 +150,7 @@ PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
   if (!out.guess.found || !startsElsewhere(T_keyframe_prior, out.guess.T_reference_current))
     return best;  // the prior already starts where the surfaces say
   PointToPlaneIcp::Result from_guess = icp_.align(cloud, out.guess.T_reference_current);
-  // An alignment that leaves directions unconstrained keeps its start along them: from the guess
-  // that start is the surfaces' word alone (generated fr1_room: degenerate steps 4-38 cm off where
-  // the guess had matched a box face to a parallel wall). Only an alignment the depth confirms in
-  // all six directions replaces the prior's, unless that one was lost. (Letting a degenerate one
-  // replace a degenerate one brought such steps back, and ok steps 4.7 cm off after them.)
-  if (betterAlignment(from_guess, best) &&
-      (from_guess.status == TrackingStatus::kOk || isLost(best))) {
+  if (betterAlignment(from_guess, best)) {
     best = std::move(from_guess);
     out.started_from_guess = true;
     out.started_from_last_pose = false;

@@ -58,8 +58,11 @@ struct SurfaceTest {
 SurfaceTest surfaceTest(const QuadricMeasurement& observation, const SurfaceNormalParams& params) {
   SurfaceTest test;
   test.quadric = &observation.quadric_camera;
-  test.max_distance = static_cast<float>(
-      std::max(params.max_distance_rms * observation.fit_rms, params.min_max_distance));
+  // The fit's RMS as a QuadricObservation message carries it (float32), so that the odometry
+  // nodelet and the offline pipeline draw the same line.
+  const double fit_rms = static_cast<float>(observation.fit_rms);
+  test.max_distance =
+      static_cast<float>(std::max(params.max_distance_rms * fit_rms, params.min_max_distance));
   test.is_plane = test.quadric->quadricClass() == QuadricClass::kPlane;
   if (test.is_plane) {
     const PlaneShape plane = planeShape(*test.quadric);  // n . p = d

@@ -205,10 +205,10 @@ TEST(ShapeRefiner, AShapeWithoutACoreQuadricIsNotRefinedAndDoesNotThrow) {
 }
 
 TEST(PrimitiveShape, PerturbThrowsWhenTheScaleStepLeavesTheClass) {
-  // The core's [+] adds the scale step unchecked; a step through alpha = 0 used to come back as a
-  // cylinder of negative radius or a cone with a half angle beyond pi/2 (no core quadric), and the
-  // refiner's next Jacobian threw from perturb() outside its guarded step (a real frame aborted
-  // bench_segmentation).
+  // A step through alpha = 0 (the core's [+] stops it at a thousandth of the scale) used to come
+  // back as a cylinder of negative radius or a cone with a half angle beyond pi/2 (no core
+  // quadric), and the refiner's next Jacobian threw from perturb() outside its guarded step (a real
+  // frame aborted bench_segmentation).
   const PrimitiveShape cylinder =
       PrimitiveShape::cylinder(Eigen::Vector3d(0, 0, 1), Eigen::Vector3d::UnitY(), 0.1);
   Eigen::VectorXd step = Eigen::VectorXd::Zero(5);
