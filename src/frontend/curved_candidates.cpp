@@ -1,7 +1,6 @@
 #include "quadric_slam/frontend/curved_candidates.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <exception>
 
@@ -139,16 +138,9 @@ CurvedCandidates findCurvedCandidates(const SegmentationFrame& frame,
   // The components are independent inputs: CGAL runs on them in parallel, each thread taking the
   // next component. CGAL's random generator is thread-local and reseeded per call, so the result
   // does not depend on the number of threads.
-  std::atomic<std::size_t> next_job{0};
-  forEachChunk(p.threads, p.threads, [&](int, int, int) {
-    for (std::size_t j = next_job++; j < jobs.size(); j = next_job++) {
-      try {
-        detectComponent(jobs[j]);
-      } catch (...) {  // rethrown on the calling thread below
-        jobs[j].error = std::current_exception();
-      }
-    }
-  });
+  forEachTask(
+      static_cast<int>(jobs.size()), p.threads, [&](int j) { detectComponent(jobs[j]); },
+      [&](int j, std::exception_ptr error) { jobs[j].error = error; });  // rethrown below
   for (ComponentJob& job : jobs) {
     if (job.error)
       std::rethrow_exception(job.error);
@@ -159,7 +151,6 @@ CurvedCandidates findCurvedCandidates(const SegmentationFrame& frame,
     return a.indices.size() > b.indices.size();
   });
   return out;
-
 }
 
 }  // namespace quadric_slam

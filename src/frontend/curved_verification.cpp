@@ -1,7 +1,6 @@
 #include "quadric_slam/frontend/curved_verification.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <optional>
 
@@ -222,19 +221,18 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
   const int width = frame.width, height = frame.height;
   CandidateVerdict verdict;
   verdict.decided = true;
-  std::vector<int> all_pixels;
-  all_pixels.reserve(candidate.indices.size());
-  for (int k : candidate.indices)
-    all_pixels.push_back(candidates.pixels[k]);
-  verdict.read_box = roiOf(all_pixels, width);
+  // All of the candidate's pixels make the box the verdict read; the free ones are its support.
+  std::vector<int> all_pixels, pixels;
   std::vector<Eigen::Vector3d> support;
-  std::vector<int> pixels;
+  all_pixels.reserve(candidate.indices.size());
   for (int k : candidate.indices) {
+    all_pixels.push_back(candidates.pixels[k]);
     if (frame.used[candidates.pixels[k]])
       continue;
     support.push_back(candidates.points[k]);
     pixels.push_back(candidates.pixels[k]);
   }
+  verdict.read_box = roiOf(all_pixels, width);
   if (static_cast<int>(support.size()) < p.cgal_min_points)
     return verdict;
   PrimitiveShape shape = candidate.shape;
@@ -245,6 +243,7 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
   verdict.read_box = unite(verdict.read_box, roi);
 
   std::vector<int> indices;
+  std::vector<Eigen::Vector3d> points;  // those of indices
   for (int pass = 0; pass < 2; ++pass) {
     if (!plausibleShape(fit.shape, p))
       break;
@@ -253,7 +252,7 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
       indices.clear();
       break;
     }
-    const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
+    points = pointsOf(cloud, indices);
     fit = refiner.refine(fit.shape, points);
     // Model selection on the first support only: the second pass re-assigns the pixels with
     // the chosen class and refines it there (selecting again there changed nothing measurable
@@ -268,7 +267,6 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
   }
   if (indices.empty() || !plausibleShape(fit.shape, p))
     return verdict;
-  const std::vector<Eigen::Vector3d> points = pointsOf(cloud, indices);
   // Degeneracy: a near-flat surface is a plane, not a curved primitive. Flat means what it means
   // to the plane region grower: the plane fits almost as well AND the normals do not bend (shape
   // operator at most the grower's max_curvature). The normals decide when the depth noise hides
@@ -335,16 +333,11 @@ int verifyCurvedCandidates(const SegmentationFrame& frame, const CurvedCandidate
   // verified again otherwise. The result is the sequential one, whatever the number of threads.
   std::vector<CandidateVerdict> verdicts(n);
   if (p.threads > 1 && n > 1) {
-    std::atomic<int> next{0};
-    forEachChunk(p.threads, p.threads, [&](int, int, int) {
-      for (int k = next++; k < n; k = next++) {
-        try {
-          verdicts[k] = verifyCandidate(frame, *curved[k], candidates, p, refiner);
-        } catch (...) {  // left undecided: verified again in order below, where it may throw
-          verdicts[k] = CandidateVerdict();
-        }
-      }
-    });
+    forEachTask(
+        n, p.threads,
+        [&](int k) { verdicts[k] = verifyCandidate(frame, *curved[k], candidates, p, refiner); },
+        // Left undecided: verified again in order below, where it may throw.
+        [&](int k, std::exception_ptr) { verdicts[k] = CandidateVerdict(); });
   }
   struct Taken {
     ImageRoi box;

@@ -261,12 +261,13 @@ PrimitiveShape perturb(const PrimitiveShape& shape, const Eigen::VectorXd& delta
   // A step through alpha = 0 leaves the class (a negative radius, a cone half angle beyond pi/2):
   // the core's [+] would stop it at a thousandth of the scale (a radius a thousand times larger,
   // another surface), so the refiner's guarded step is told here instead.
-  const Eigen::Vector3d scale =
-      quadric.scale() + (classDefinition(shape.quadric_class).basis * delta).tail<3>();
+  const Vector9d step =
+      classDefinition(shape.quadric_class).basis * delta;  // plusMinimal's B delta
+  const Eigen::Vector3d scale = quadric.scale() + step.tail<3>();
   if (!(scale.minCoeff() > 0) || !scale.allFinite())
     throw std::invalid_argument("perturb: the step leaves the class (scale " +
                                 std::to_string(scale.minCoeff()) + " <= 0)");
-  return PrimitiveShape::fromQuadric(quadric.plusMinimal(delta));
+  return PrimitiveShape::fromQuadric(quadric.plus(step));
 }
 
 }  // namespace quadric_slam

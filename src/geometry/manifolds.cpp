@@ -132,8 +132,7 @@ bool QuadricManifold::Plus(const double* x, const double* delta, double* x_plus_
   // instead (returning false) makes Ceres end the whole solve when its projected-gradient test,
   // Plus(x, -gradient), fails.
   for (int i = 0; i < 3; ++i)
-    x_plus_delta[7 + i] =
-        std::max(x[7 + i] + general[6 + i], QuadricModel::kMinScaleStepFraction * x[7 + i]);
+    x_plus_delta[7 + i] = QuadricModel::stepScale(x[7 + i], general[6 + i]);
   return true;
 }
 

@@ -217,7 +217,8 @@ QuadricModel QuadricModel::transformed(const Eigen::Isometry3d& T_A_frame) const
 QuadricModel QuadricModel::plus(const Vector9d& delta) const {
   QuadricModel out = *this;
   out.T_frame_quadric_ = quadric_slam::plus(T_frame_quadric_, delta.head<6>());
-  out.scale_ = (scale_ + delta.tail<3>()).cwiseMax(kMinScaleStepFraction * scale_);
+  for (int i = 0; i < 3; ++i)
+    out.scale_(i) = stepScale(scale_(i), delta(6 + i));
   return out;
 }
 

@@ -1,5 +1,7 @@
 #include "quadric_slam/geometry/surface_matcher.h"
 
+#include "quadric_slam/types/param_checks.h"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <algorithm>
@@ -57,7 +59,9 @@ struct DirectionFeature {
 };
 
 // Surfaces whose direction is an axis without a sign.
-bool axial(Kind kind) { return kind == Kind::kCylinder || kind == Kind::kCone; }
+bool axial(Kind kind) {
+  return kind == Kind::kCylinder || kind == Kind::kCone;
+}
 
 std::vector<DirectionFeature> directionFeatures(const std::vector<MatchableSurface>& surfaces,
                                                 int max_count, bool both_cylinder_signs) {
@@ -181,7 +185,8 @@ class Hypotheses {
   }
 
   bool withinPrior(const Eigen::Matrix3d& R) const {
-    return !prior_ || rotationAngle(R, prior_->T_reference_current.linear()) <= prior_->max_rotation;
+    return !prior_ ||
+           rotationAngle(R, prior_->T_reference_current.linear()) <= prior_->max_rotation;
   }
   bool withinPrior(const Eigen::Vector3d& t) const {
     return !prior_ ||
@@ -295,8 +300,8 @@ std::vector<SurfaceAlignment> Hypotheses::run() const {
   const double cos_prior_reach =
       prior_ ? std::cos(std::min(M_PI, prior_->max_rotation + p_.max_angle_difference)) : -1.0;
   const auto reachable = [&](const DirectionFeature& c, const DirectionFeature& r) {
-    return !prior_ || (prior_->T_reference_current.linear() * c.direction).dot(r.direction) >=
-                          cos_prior_reach;
+    return !prior_ ||
+           (prior_->T_reference_current.linear() * c.direction).dot(r.direction) >= cos_prior_reach;
   };
   for (std::size_t a = 0; a < cur_dirs.size(); ++a) {
     for (std::size_t b = a + 1; b < cur_dirs.size(); ++b) {
@@ -320,8 +325,7 @@ std::vector<SurfaceAlignment> Hypotheses::run() const {
           if (std::abs(ref_angle[i * n_ref + j] - cur_angle) > p_.max_angle_difference ||
               !reachable(cb, rb))
             continue;
-          const Eigen::Matrix3d R =
-              kabsch(cur_frame, directionFrame(ra.direction, rb.direction));
+          const Eigen::Matrix3d R = kabsch(cur_frame, directionFrame(ra.direction, rb.direction));
           if (!withinPrior(R))
             continue;
           TriedRotation& entry = rotationEntry(R);
@@ -437,23 +441,19 @@ int appendMatchableSurface(const QuadricModel& quadric, int source, double weigh
 }
 
 void SurfaceMatcher::Params::validate() const {
-  auto fail = [](const std::string& field, const std::string& range, double value) {
-    std::ostringstream why;
-    why << "SurfaceMatcher: " << field << " must be in " << range << ", got " << value;
-    throw std::invalid_argument(why.str());
-  };
+  const ParamRangeCheck check("SurfaceMatcher::Params");
   if (!(max_angle_difference > 0 && max_angle_difference <= 0.5))
-    fail("max_angle_difference", "(0, 0.5] rad", max_angle_difference);
+    check.fail("max_angle_difference", "(0, 0.5] rad", max_angle_difference);
   if (!(max_offset_difference > 0 && max_offset_difference <= 1))
-    fail("max_offset_difference", "(0, 1] m", max_offset_difference);
+    check.fail("max_offset_difference", "(0, 1] m", max_offset_difference);
   if (!(max_radius_fraction > 0 && max_radius_fraction < 1))
-    fail("max_radius_fraction", "(0, 1)", max_radius_fraction);
+    check.fail("max_radius_fraction", "(0, 1)", max_radius_fraction);
   if (!(min_pair_angle > 0 && min_pair_angle < M_PI / 2))
-    fail("min_pair_angle", "(0, pi/2) rad", min_pair_angle);
+    check.fail("min_pair_angle", "(0, pi/2) rad", min_pair_angle);
   if (max_current_features < 2 || max_current_features > 64)
-    fail("max_current_features", "[2, 64]", max_current_features);
+    check.fail("max_current_features", "[2, 64]", max_current_features);
   if (max_reference_features < 2 || max_reference_features > 64)
-    fail("max_reference_features", "[2, 64]", max_reference_features);
+    check.fail("max_reference_features", "[2, 64]", max_reference_features);
 }
 
 SurfaceMatcher::SurfaceMatcher(const Params& params) : params_((params.validate(), params)) {}

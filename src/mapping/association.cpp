@@ -10,8 +10,8 @@
 #include "quadric_slam/geometry/quadric_classes.h"
 #include "quadric_slam/mapping/measurement_model_error.h"
 #include "quadric_slam/mapping/observation_linearization.h"
-#include "quadric_slam/mapping/param_checks.h"
 #include "quadric_slam/mapping/surface_fusion.h"
+#include "quadric_slam/types/param_checks.h"
 
 namespace quadric_slam {
 

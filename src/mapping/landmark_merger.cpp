@@ -6,8 +6,8 @@
 #include <string>
 
 #include "quadric_slam/mapping/association.h"
-#include "quadric_slam/mapping/param_checks.h"
 #include "quadric_slam/mapping/surface_fusion.h"
+#include "quadric_slam/types/param_checks.h"
 
 namespace quadric_slam {
 

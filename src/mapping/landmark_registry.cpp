@@ -7,7 +7,7 @@
 
 #include "quadric_slam/geometry/symmetry.h"
 #include "quadric_slam/mapping/association_cross_class.h"
-#include "quadric_slam/mapping/param_checks.h"
+#include "quadric_slam/types/param_checks.h"
 
 namespace quadric_slam {
 

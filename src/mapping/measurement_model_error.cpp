@@ -7,7 +7,7 @@
 #include <string>
 
 #include "quadric_slam/geometry/quadric_class.h"
-#include "quadric_slam/mapping/param_checks.h"
+#include "quadric_slam/types/param_checks.h"
 
 namespace quadric_slam {
 

@@ -7,7 +7,7 @@
 
 #include "quadric_slam/mapping/factors.h"
 #include "quadric_slam/mapping/motion_bound.h"
-#include "quadric_slam/mapping/param_checks.h"
+#include "quadric_slam/types/param_checks.h"
 
 namespace quadric_slam {
 

@@ -1,5 +1,7 @@
 #include "quadric_slam/mapping/relocaliser.h"
 
+#include "quadric_slam/types/param_checks.h"
+
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <sstream>
@@ -37,19 +39,15 @@ ExtentBox boxOf(const Eigen::Vector3d& min, const Eigen::Vector3d& max) {
 
 void Relocaliser::Params::validate() const {
   matcher.validate();
-  auto fail = [](const std::string& field, const std::string& range, double value) {
-    std::ostringstream why;
-    why << "Relocaliser: " << field << " must be in " << range << ", got " << value;
-    throw std::invalid_argument(why.str());
-  };
+  const ParamRangeCheck check("Relocaliser::Params");
   if (min_supporting_surfaces < 3 || min_supporting_surfaces > 100)
-    fail("min_supporting_surfaces", "[3, 100]", min_supporting_surfaces);
+    check.fail("min_supporting_surfaces", "[3, 100]", min_supporting_surfaces);
   if (!(max_ambiguity > 0 && max_ambiguity <= 1))
-    fail("max_ambiguity", "(0, 1]", max_ambiguity);
+    check.fail("max_ambiguity", "(0, 1]", max_ambiguity);
   if (!(extent_margin >= 0 && extent_margin <= 10))
-    fail("extent_margin", "[0, 10] m", extent_margin);
+    check.fail("extent_margin", "[0, 10] m", extent_margin);
   if (min_plane_points < 0)
-    fail("min_plane_points", "[0, inf)", min_plane_points);
+    check.fail("min_plane_points", "[0, inf)", min_plane_points);
 }
 
 Relocaliser::Relocaliser(const Params& params)
@@ -65,9 +63,9 @@ Relocalisation Relocaliser::relocalise(const std::vector<QuadricMeasurement>& ob
     if (m.quadric_camera.quadricClass() == QuadricClass::kPlane &&
         m.num_points < params_.min_plane_points)
       continue;
-    out.usable_observations += appendMatchableSurface(
-        m.quadric_camera, static_cast<int>(i), std::sqrt(std::max(1, m.num_points)),
-        /*plane_towards_origin=*/true, &current);
+    out.usable_observations += appendMatchableSurface(m.quadric_camera, static_cast<int>(i),
+                                                      std::sqrt(std::max(1, m.num_points)),
+                                                      /*plane_towards_origin=*/true, &current);
   }
   // The map's surfaces: a plane of either side; the larger its observed extent, the earlier it
   // proposes rotations (weight = the extent's diagonal, 1 m when unknown).
@@ -76,8 +74,9 @@ Relocalisation Relocaliser::relocalise(const std::vector<QuadricMeasurement>& ob
   for (const auto& [id, landmark] : landmarks) {
     const ExtentBox box = boxOf(landmark.extent_min, landmark.extent_max);
     const double size = box.known() ? (box.max - box.min).norm() : 1.0;
-    const int added = appendMatchableSurface(landmark.quadric_map, static_cast<int>(landmark_of.size()),
-                                             size, /*plane_towards_origin=*/false, &reference);
+    const int added =
+        appendMatchableSurface(landmark.quadric_map, static_cast<int>(landmark_of.size()), size,
+                               /*plane_towards_origin=*/false, &reference);
     if (added > 0) {
       ++out.usable_landmarks;
       landmark_of.push_back(&landmark);
@@ -110,8 +109,8 @@ Relocalisation Relocaliser::relocalise(const std::vector<QuadricMeasurement>& ob
     out.message = "no pair of non-parallel surfaces matches the map";
     return out;
   }
-  const SurfaceAlignment best = matcher_.refine(reference, current, alignments.front(),
-                                                extents_overlap);
+  const SurfaceAlignment best =
+      matcher_.refine(reference, current, alignments.front(), extents_overlap);
   for (const SurfaceAlignment& other : alignments) {
     if (!samePose(other.T_reference_current, best.T_reference_current) &&
         !samePose(other.T_reference_current, alignments.front().T_reference_current)) {
@@ -135,14 +134,15 @@ Relocalisation Relocaliser::relocalise(const std::vector<QuadricMeasurement>& ob
   } else if (out.runner_up_surfaces >= params_.max_ambiguity * best.supporting &&
              out.runner_up_weight >= params_.max_ambiguity * best.weight) {
     why << "ambiguous: another pose explains " << out.runner_up_surfaces << " of "
-        << best.supporting << " surfaces (support " << out.runner_up_weight << " of "
-        << best.weight << ")";
+        << best.supporting << " surfaces (support " << out.runner_up_weight << " of " << best.weight
+        << ")";
   } else {
     Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
     for (const auto& [c, r] : best.pairs)
       if (current[c].kind != MatchableSurface::Kind::kSphere)
         spread += current[c].weight * current[c].direction * current[c].direction.transpose();
-    const Eigen::Vector3d eig = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread).eigenvalues();
+    const Eigen::Vector3d eig =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(spread).eigenvalues();
     if (eig(1) < kMinDirectionSpread * eig(2))
       why << "the supporting surfaces share one direction: the rotation about it is free";
   }

@@ -13,9 +13,9 @@
 #include "quadric_slam/geometry/manifolds.h"
 #include "quadric_slam/mapping/factors.h"
 #include "quadric_slam/mapping/observation_linearization.h"
-#include "quadric_slam/mapping/param_checks.h"
 #include "quadric_slam/mapping/solver_setup.h"
 #include "quadric_slam/mapping/surface_fusion.h"
+#include "quadric_slam/types/param_checks.h"
 
 namespace quadric_slam {
 

@@ -1,5 +1,7 @@
 #include "quadric_slam/odometry/odometry_tracker.h"
 
+#include "quadric_slam/types/param_checks.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -10,35 +12,31 @@ namespace quadric_slam {
 
 void OdometryTracker::Params::validate() const {
   icp.validate();
-  auto fail = [](const std::string& field, const std::string& range, double value) {
-    std::ostringstream why;
-    why << field << " must be in " << range << ", got " << value;
-    throw std::invalid_argument(why.str());
-  };
+  const ParamRangeCheck check("OdometryTracker::Params");
   if (!(keyframe_translation > 0 && std::isfinite(keyframe_translation)))
-    fail("keyframe_translation", "(0, inf) m", keyframe_translation);
+    check.fail("keyframe_translation", "(0, inf) m", keyframe_translation);
   if (!(keyframe_rotation > 0 && keyframe_rotation <= M_PI))
-    fail("keyframe_rotation", "(0, pi] rad", keyframe_rotation);
+    check.fail("keyframe_rotation", "(0, pi] rad", keyframe_rotation);
   if (!(keyframe_min_overlap >= 0 && keyframe_min_overlap <= 1))
-    fail("keyframe_min_overlap", "[0, 1]", keyframe_min_overlap);
+    check.fail("keyframe_min_overlap", "[0, 1]", keyframe_min_overlap);
   if (lost_frames_before_new_keyframe < 1 || lost_frames_before_new_keyframe > 1000)
-    fail("lost_frames_before_new_keyframe", "[1, 1000]", lost_frames_before_new_keyframe);
+    check.fail("lost_frames_before_new_keyframe", "[1, 1000]", lost_frames_before_new_keyframe);
   if (!(guess_min_translation > 0 && std::isfinite(guess_min_translation)))
-    fail("guess_min_translation", "(0, inf) m", guess_min_translation);
+    check.fail("guess_min_translation", "(0, inf) m", guess_min_translation);
   if (!(guess_min_rotation > 0 && guess_min_rotation <= M_PI))
-    fail("guess_min_rotation", "(0, pi] rad", guess_min_rotation);
+    check.fail("guess_min_rotation", "(0, pi] rad", guess_min_rotation);
   if (!(guess_skip_inlier_fraction > 0 && guess_skip_inlier_fraction <= 1))
-    fail("guess_skip_inlier_fraction", "(0, 1]", guess_skip_inlier_fraction);
+    check.fail("guess_skip_inlier_fraction", "(0, 1]", guess_skip_inlier_fraction);
   if (!(increment_covariance_scale > 0 && increment_covariance_scale <= 1e6))
-    fail("increment_covariance_scale", "(0, 1e6]", increment_covariance_scale);
+    check.fail("increment_covariance_scale", "(0, 1e6]", increment_covariance_scale);
   if (!(increment_translation_fraction >= 0 && std::isfinite(increment_translation_fraction)))
-    fail("increment_translation_fraction", "[0, inf)", increment_translation_fraction);
+    check.fail("increment_translation_fraction", "[0, inf)", increment_translation_fraction);
   if (!(velocity_hold_time >= 0 && velocity_hold_time <= 10))
-    fail("velocity_hold_time", "[0, 10] s", velocity_hold_time);
+    check.fail("velocity_hold_time", "[0, 10] s", velocity_hold_time);
   if (!(velocity_min_information >= 0 && velocity_min_information <= 1000))
-    fail("velocity_min_information", "[0, 1000]", velocity_min_information);
+    check.fail("velocity_min_information", "[0, 1000]", velocity_min_information);
   if (!(increment_rotation_per_metre >= 0 && std::isfinite(increment_rotation_per_metre)))
-    fail("increment_rotation_per_metre", "[0, inf) rad/m", increment_rotation_per_metre);
+    check.fail("increment_rotation_per_metre", "[0, inf) rad/m", increment_rotation_per_metre);
   guess.validate();
   surface_normals.validate();
 }
@@ -47,9 +45,10 @@ OdometryTracker::OdometryTracker(const Params& params)
     : params_((params.validate(), params)), icp_(params.icp), guesser_(params.guess) {}
 
 int OdometryTracker::adoptSurfaceNormals(const std::vector<QuadricMeasurement>& observations,
-                                         Cloud& cloud) const {
+                                         Cloud& cloud) {
   const int stride = std::gcd(params_.icp.reference_stride, params_.icp.finest_stride);
-  return quadric_slam::adoptSurfaceNormals(observations, params_.surface_normals, stride, cloud);
+  return quadric_slam::adoptSurfaceNormals(observations, params_.surface_normals, stride, cloud,
+                                           &surface_normal_scratch_);
 }
 
 void OdometryTracker::reset() {

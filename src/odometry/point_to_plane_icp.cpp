@@ -1,6 +1,7 @@
 #include "quadric_slam/odometry/point_to_plane_icp.h"
 
 #include "quadric_slam/odometry/constrained_directions.h"
+#include "quadric_slam/types/param_checks.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -12,18 +13,6 @@
 #include <stdexcept>
 
 namespace quadric_slam {
-namespace {
-
-void require(bool ok, const std::string& field, const std::string& range, double value) {
-  if (!ok) {
-    std::ostringstream why;
-    why << field << " must be in " << range << ", got " << value;
-    throw std::invalid_argument(why.str());
-  }
-}
-
-}  // namespace
-
 const char* toString(TrackingStatus status) {
   switch (status) {
     case TrackingStatus::kOk:
@@ -59,6 +48,7 @@ int organizedCloudDecimation(const CameraIntrinsics& intrinsics, int cloud_width
 }
 
 void PointToPlaneIcp::Params::validate() const {
+  const ParamRangeCheck require("PointToPlaneIcp::Params");
   require(pyramid_levels >= 1 && pyramid_levels <= 6, "pyramid_levels", "[1, 6]", pyramid_levels);
   require(finest_stride >= 1 && finest_stride <= 32, "finest_stride", "[1, 32]", finest_stride);
   require(reference_stride >= 1 && reference_stride <= 16, "reference_stride", "[1, 16]",

@@ -1,5 +1,7 @@
 #include "quadric_slam/odometry/quadric_motion_guess.h"
 
+#include "quadric_slam/types/param_checks.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -59,21 +61,17 @@ const SurfaceAlignment& nearestOfTheBest(const std::vector<SurfaceAlignment>& pr
 }  // namespace
 
 void QuadricMotionGuesser::Params::validate() const {
-  auto fail = [](const std::string& field, const std::string& range, double value) {
-    std::ostringstream why;
-    why << field << " must be in " << range << ", got " << value;
-    throw std::invalid_argument(why.str());
-  };
+  const ParamRangeCheck check("QuadricMotionGuesser::Params");
   if (min_plane_points < 0)
-    fail("min_plane_points", "[0, inf)", min_plane_points);
+    check.fail("min_plane_points", "[0, inf)", min_plane_points);
   if (max_direction_features < 2 || max_direction_features > 64)
-    fail("max_direction_features", "[2, 64]", max_direction_features);
+    check.fail("max_direction_features", "[2, 64]", max_direction_features);
   if (!(max_rotation_from_prior > 0 && max_rotation_from_prior <= M_PI))
-    fail("max_rotation_from_prior", "(0, pi] rad", max_rotation_from_prior);
+    check.fail("max_rotation_from_prior", "(0, pi] rad", max_rotation_from_prior);
   if (!(max_translation_from_prior > 0 && std::isfinite(max_translation_from_prior)))
-    fail("max_translation_from_prior", "(0, inf) m", max_translation_from_prior);
+    check.fail("max_translation_from_prior", "(0, inf) m", max_translation_from_prior);
   if (min_supporting_surfaces < 2 || min_supporting_surfaces > 1000)
-    fail("min_supporting_surfaces", "[2, 1000]", min_supporting_surfaces);
+    check.fail("min_supporting_surfaces", "[2, 1000]", min_supporting_surfaces);
   // The matching tolerances (angles, offsets, radii, pair angle) are the matcher's to check.
   matcherParams(*this).validate();
 }

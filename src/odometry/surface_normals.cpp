@@ -1,5 +1,7 @@
 #include "quadric_slam/odometry/surface_normals.h"
 
+#include "quadric_slam/types/param_checks.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -13,13 +15,7 @@
 namespace quadric_slam {
 
 void SurfaceNormalParams::validate() const {
-  auto require = [](bool ok, const std::string& field, const std::string& range, double value) {
-    if (ok)
-      return;
-    std::ostringstream why;
-    why << field << " must be in " << range << ", got " << value;
-    throw std::invalid_argument(why.str());
-  };
+  const ParamRangeCheck require("SurfaceNormalParams");
   require(max_distance_rms > 0 && max_distance_rms <= 100, "surface_normal_max_distance_rms",
           "(0, 100]", max_distance_rms);
   require(min_max_distance >= 0 && min_max_distance <= 1, "surface_normal_min_max_distance",
@@ -76,7 +72,7 @@ SurfaceTest surfaceTest(const QuadricMeasurement& observation, const SurfaceNorm
 
 int adoptSurfaceNormals(const std::vector<QuadricMeasurement>& observations,
                         const SurfaceNormalParams& params, int stride,
-                        pcl::PointCloud<pcl::PointNormal>& cloud) {
+                        pcl::PointCloud<pcl::PointNormal>& cloud, SurfaceNormalScratch* scratch) {
   if (stride < 1)
     throw std::invalid_argument("adoptSurfaceNormals: stride must be >= 1");
   if (!params.enabled || observations.empty() || !cloud.isOrganized())
@@ -98,8 +94,12 @@ int adoptSurfaceNormals(const std::vector<QuadricMeasurement>& observations,
   // point's own normal, so that of two surfaces meeting at an edge each keeps its side); then
   // the winners' normals are written.
   const std::size_t size = static_cast<std::size_t>(grid_width) * grid_height;
-  std::vector<float> claimed_distance(size, std::numeric_limits<float>::infinity());
-  std::vector<int> claimed_by(size, -1);
+  SurfaceNormalScratch local;
+  SurfaceNormalScratch& work = scratch != nullptr ? *scratch : local;
+  work.claimed_distance.assign(size, std::numeric_limits<float>::infinity());
+  work.claimed_by.assign(size, -1);
+  std::vector<float>& claimed_distance = work.claimed_distance;
+  std::vector<int>& claimed_by = work.claimed_by;
   for (std::size_t s = 0; s < tests.size(); ++s) {
     const SurfaceTest& test = tests[s];
     const ImageRoi& roi = observations[s].image_roi;

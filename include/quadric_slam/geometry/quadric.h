@@ -8,6 +8,8 @@
 // (msg/QuadricSurface.msg cites "eq. 5" for the composition: eqs. 4 and 5 together.)
 #pragma once
 
+#include <algorithm>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -66,6 +68,11 @@ class QuadricModel {
   // -0.06 m).
   QuadricModel plus(const Vector9d& delta) const;
   static constexpr double kMinScaleStepFraction = 1e-3;
+  // One scale after a step, as plus() takes it: scale + step, but not below
+  // kMinScaleStepFraction * scale.
+  static double stepScale(double scale, double step) {
+    return std::max(scale + step, kMinScaleStepFraction * scale);
+  }
   // pi [-] pi' = [log(T'^-1 T)^vee; D^-1(S - S')] (eqs. 10, 14, 17). Exact inverse of plus() where
   // plus() leaves the scales above that bound.
   Vector9d minus(const QuadricModel& other) const;

@@ -133,7 +133,7 @@ class OdometryTracker {
   // (Params::surface_normals; odometry/surface_normals.h), on the grid the ICP reads (every
   // gcd(reference_stride, finest_stride)-th point). Call it before track() with the same
   // observations. Returns the number of normals replaced.
-  int adoptSurfaceNormals(const std::vector<QuadricMeasurement>& observations, Cloud& cloud) const;
+  int adoptSurfaceNormals(const std::vector<QuadricMeasurement>& observations, Cloud& cloud);
 
   // Forgets the keyframe, pose and velocity: the next usable frame starts a new odom frame.
   void reset();
@@ -162,6 +162,7 @@ class OdometryTracker {
   Params params_;
   PointToPlaneIcp icp_;
   QuadricMotionGuesser guesser_;
+  SurfaceNormalScratch surface_normal_scratch_;  // adoptSurfaceNormals' buffers, kept
   // The keyframe's observations without their supporting points (empty when none were given).
   std::vector<QuadricMeasurement> keyframe_observations_;
   bool initialized_ = false;

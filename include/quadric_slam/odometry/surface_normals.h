@@ -49,9 +49,15 @@ struct SurfaceNormalParams {
 // image_roi in the cloud's grid. Returns the number of points whose normal was replaced. Does
 // nothing (returns 0) when params.enabled is false. Only every stride-th point in u and v (from
 // (0, 0)) is looked at: the ICP reads no other (OdometryTracker::adoptSurfaceNormals). Throws
-// std::invalid_argument when stride < 1.
+// std::invalid_argument when stride < 1. scratch, when given, keeps the per-point buffers from one
+// call to the next (a frame's grid is the same size every time).
+struct SurfaceNormalScratch {
+  std::vector<float> claimed_distance;  // distance to the surface that claimed the point
+  std::vector<int> claimed_by;          // that surface's index, -1: none
+};
 int adoptSurfaceNormals(const std::vector<QuadricMeasurement>& observations,
                         const SurfaceNormalParams& params, int stride,
-                        pcl::PointCloud<pcl::PointNormal>& cloud);
+                        pcl::PointCloud<pcl::PointNormal>& cloud,
+                        SurfaceNormalScratch* scratch = nullptr);
 
 }  // namespace quadric_slam

@@ -134,6 +134,27 @@ TEST(SurfaceNormals, TheNearerOfTwoSurfacesWinsAndOnlyTheStrideGridIsTouched) {
   }
 }
 
+// The scratch buffers carried from a frame with a surface everywhere to one with a surface in one
+// corner hold nothing over: each call gives what a call without them gives.
+TEST(SurfaceNormals, ReusedScratchGivesTheSameNormalsAsFreshBuffers) {
+  std::mt19937 rng(9);
+  const pcl::PointCloud<pcl::PointNormal> wall = noisyWall(3.0, 0.05, rng);
+  const std::vector<QuadricMeasurement> everywhere{
+      planeObservation(Eigen::Vector3d::UnitZ(), 3.0, 0.02, ImageRoi{0, 0, kWidth, kHeight})};
+  const std::vector<QuadricMeasurement> corner{planeObservation(
+      Eigen::Vector3d::UnitZ(), 3.0, 0.02, ImageRoi{0, 0, kWidth / 4, kHeight / 4})};
+  SurfaceNormalScratch scratch;
+  for (const auto* observations : {&everywhere, &corner}) {
+    pcl::PointCloud<pcl::PointNormal> fresh = wall, reused = wall;
+    const int fresh_count = adoptSurfaceNormals(*observations, SurfaceNormalParams{}, 2, fresh);
+    EXPECT_EQ(adoptSurfaceNormals(*observations, SurfaceNormalParams{}, 2, reused, &scratch),
+              fresh_count);
+    EXPECT_GT(fresh_count, 0);
+    for (std::size_t i = 0; i < wall.size(); ++i)
+      EXPECT_EQ(angleToMinusZ(fresh.points[i]), angleToMinusZ(reused.points[i])) << i;
+  }
+}
+
 TEST(SurfaceNormals, InvalidParametersAndStrideAreRefused) {
   SurfaceNormalParams params;
   params.max_angle = 0;
