@@ -1,5 +1,6 @@
 #include "quadric_slam/odometry/odometry_tracker.h"
 
+#include "quadric_slam/odometry/alignment_choice.h"
 #include "quadric_slam/types/param_checks.h"
 
 #include <algorithm>
@@ -97,51 +98,6 @@ OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_
   out.covariance = M * covariance_ * M.transpose();
   return out;
 }
-
-namespace {
-
-bool isLost(const PointToPlaneIcp::Result& r) {
-  return r.status == TrackingStatus::kLost;
-}
-
-// a is the better alignment than b: not lost when b is; else more inlier correspondences (beyond
-// 2%); at counts within 2% of each other, the smaller residual.
-bool betterAlignment(const PointToPlaneIcp::Result& a, const PointToPlaneIcp::Result& b) {
-  if (isLost(a) != isLost(b))
-    return isLost(b);
-  if (a.correspondences > 1.02 * b.correspondences)
-    return true;
-  if (b.correspondences > 1.02 * a.correspondences)
-    return false;
-  return a.rms_residual < b.rms_residual;
-}
-
-// How many more inliers (as a share of the prior's) a degenerate alignment from the surfaces'
-// guess needs, when it leaves one more direction free than the prior's, to replace it.
-constexpr double kGuessExtraCorrespondences = 0.05;
-
-// The alignment from the surfaces' guess replaces the prior's when it is the better one and the
-// depth backs the guess. An alignment keeps its start along the directions it leaves free, and
-// there the guess is the surfaces' word alone: a box face matched to a parallel wall moved the
-// camera 31-38 cm on generated fr1_room when every better guess alignment was taken. So a
-// degenerate one replaces a degenerate (not lost) prior's only when it constrains more directions,
-// or holds clearly more points while leaving at most one more direction free: from a prior 10 cm
-// and 7 degrees off, a desk's top and side seen from above match only the top (3 of 6
-// directions), from the guess top and side (5 of 6; the desk at 3 and 1.5 Hz).
-bool guessAlignmentReplaces(const PointToPlaneIcp::Result& from_guess,
-                            const PointToPlaneIcp::Result& from_prior) {
-  if (!betterAlignment(from_guess, from_prior))
-    return false;
-  if (from_guess.status == TrackingStatus::kOk || isLost(from_prior))
-    return true;
-  if (from_guess.constrained_dof > from_prior.constrained_dof)
-    return true;
-  return from_guess.constrained_dof + 1 >= from_prior.constrained_dof &&
-         from_guess.correspondences >
-             (1.0 + kGuessExtraCorrespondences) * from_prior.correspondences;
-}
-
-}  // namespace
 
 bool OdometryTracker::startsElsewhere(const Eigen::Isometry3d& a,
                                       const Eigen::Isometry3d& b) const {

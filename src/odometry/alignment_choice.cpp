@@ -1,0 +1,35 @@
+#include "quadric_slam/odometry/alignment_choice.h"
+
+namespace quadric_slam {
+namespace {
+
+bool isLost(const PointToPlaneIcp::Result& r) {
+  return r.status == TrackingStatus::kLost;
+}
+
+}  // namespace
+
+bool betterAlignment(const PointToPlaneIcp::Result& a, const PointToPlaneIcp::Result& b) {
+  if (isLost(a) != isLost(b))
+    return isLost(b);
+  if (a.correspondences > 1.02 * b.correspondences)
+    return true;
+  if (b.correspondences > 1.02 * a.correspondences)
+    return false;
+  return a.rms_residual < b.rms_residual;
+}
+
+bool guessAlignmentReplaces(const PointToPlaneIcp::Result& from_guess,
+                            const PointToPlaneIcp::Result& from_prior) {
+  if (!betterAlignment(from_guess, from_prior))
+    return false;
+  if (from_guess.status == TrackingStatus::kOk || isLost(from_prior))
+    return true;
+  if (from_guess.constrained_dof > from_prior.constrained_dof)
+    return true;
+  return from_guess.constrained_dof + 1 >= from_prior.constrained_dof &&
+         from_guess.correspondences >
+             (1.0 + kGuessExtraCorrespondences) * from_prior.correspondences;
+}
+
+}  // namespace quadric_slam
