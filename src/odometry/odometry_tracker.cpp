@@ -40,10 +40,16 @@ void OdometryTracker::Params::validate() const {
     check.fail("increment_rotation_per_metre", "[0, inf) rad/m", increment_rotation_per_metre);
   guess.validate();
   surface_normals.validate();
+  photometric.validate();
+  if (!(photometric_information_scale > 0 && photometric_information_scale <= 1))
+    check.fail("photometric_information_scale", "(0, 1]", photometric_information_scale);
 }
 
 OdometryTracker::OdometryTracker(const Params& params)
-    : params_((params.validate(), params)), icp_(params.icp), guesser_(params.guess) {}
+    : params_((params.validate(), params)),
+      icp_(params.icp),
+      guesser_(params.guess),
+      photometric_(params.photometric) {}
 
 int OdometryTracker::adoptSurfaceNormals(const std::vector<QuadricMeasurement>& observations,
                                          Cloud& cloud) {
@@ -56,6 +62,7 @@ void OdometryTracker::reset() {
   initialized_ = false;
   icp_.clearReference();
   keyframe_observations_.clear();
+  keyframe_intensity_ = IntensityPyramid();
   T_odom_keyframe_ = T_odom_camera_ = last_motion_ = Eigen::Isometry3d::Identity();
   keyframe_covariance_ = covariance_ = keyframe_relative_covariance_ = Matrix6::Zero();
   velocity_dt_ = velocity_stamp_ = last_stamp_ = 0;
@@ -63,8 +70,11 @@ void OdometryTracker::reset() {
 }
 
 void OdometryTracker::setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics,
-                                  const std::vector<QuadricMeasurement>* observations) {
+                                  const std::vector<QuadricMeasurement>* observations,
+                                  IntensityPyramid& intensity) {
   icp_.setReference(cloud, intrinsics);
+  keyframe_intensity_ = std::move(intensity);
+  intensity = IntensityPyramid();
   keyframe_observations_.clear();
   if (observations) {
     for (const QuadricMeasurement& m : *observations) {
@@ -138,14 +148,26 @@ PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
   return best;
 }
 
-OdometryTracker::Result OdometryTracker::track(
-    const Cloud& cloud, const CameraIntrinsics& intrinsics, double stamp,
-    const std::vector<QuadricMeasurement>* observations) {
+OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
+                                               const CameraIntrinsics& intrinsics, double stamp,
+                                               const std::vector<QuadricMeasurement>* observations,
+                                               const cv::Mat* image) {
   std::string problem;
   if (organizedCloudDecimation(intrinsics, static_cast<int>(cloud.width),
                                static_cast<int>(cloud.height), &problem) == 0)
     throw std::invalid_argument("OdometryTracker::track: " + problem);
   const auto usable = [&] { return icp_.usablePoints(cloud) >= params_.icp.min_correspondences; };
+  // The frame's intensities, for the photometric refinement and as the next keyframe's.
+  // Built when first needed: a degenerate alignment refines with it, a new keyframe keeps it.
+  const bool have_image = params_.photometric_refinement && image && !image->empty() &&
+                          image->cols == intrinsics.width && image->rows == intrinsics.height &&
+                          (image->type() == CV_8UC1 || image->type() == CV_8UC3);
+  IntensityPyramid intensity_storage;
+  const auto frameIntensity = [&]() -> IntensityPyramid& {
+    if (have_image && intensity_storage.empty())
+      intensity_storage = IntensityPyramid::fromImage(*image, params_.photometric.levels);
+    return intensity_storage;
+  };
 
   if (!initialized_) {
     if (!usable()) {
@@ -156,7 +178,7 @@ OdometryTracker::Result OdometryTracker::track(
     }
     T_odom_camera_ = Eigen::Isometry3d::Identity();
     covariance_ = Matrix6::Zero();
-    setKeyframe(cloud, intrinsics, observations);
+    setKeyframe(cloud, intrinsics, observations, frameIntensity());
     initialized_ = true;
     last_motion_ = Eigen::Isometry3d::Identity();
     velocity_dt_ = 0;
@@ -182,6 +204,9 @@ OdometryTracker::Result OdometryTracker::track(
   Result out;
   PointToPlaneIcp::Result icp = alignFromBestStart(
       cloud, T_keyframe_odom * prediction, T_keyframe_odom * T_odom_camera_, observations, out);
+  const bool photometric =
+      have_image && icp.status == TrackingStatus::kDegenerate && !keyframe_intensity_.empty() &&
+      refinePhotometrically(cloud, intrinsics, frameIntensity(), icp, out.photometric);
 
   const Eigen::Isometry3d previous = T_odom_camera_;
   bool new_keyframe = false;
@@ -210,7 +235,7 @@ OdometryTracker::Result OdometryTracker::track(
     velocity_dt_ = 0;
     covariance_ += Matrix6::Identity() * params_.icp.degenerate_variance;
     if (consecutive_lost_ >= params_.lost_frames_before_new_keyframe && usable()) {
-      setKeyframe(cloud, intrinsics, observations);
+      setKeyframe(cloud, intrinsics, observations, frameIntensity());
       new_keyframe = true;
     }
   } else {
@@ -242,8 +267,9 @@ OdometryTracker::Result OdometryTracker::track(
     // degenerate step the last confirmed velocity is kept (not this step's motion) while it is at
     // most velocity_hold_time old: a hand-held camera keeps moving along a far wall that cannot
     // measure it, and zero motion there is as wrong as a velocity carried for long.
-    if (icp.status == TrackingStatus::kOk &&
-        icp.information_over_noise >= params_.velocity_min_information) {
+    if ((icp.status == TrackingStatus::kOk &&
+         icp.information_over_noise >= params_.velocity_min_information) ||
+        photometric) {
       last_motion_ = pose_math::orthonormalized(previous.inverse() * T_odom_camera_);
       velocity_dt_ = dt > 0 ? dt : 0;
       velocity_stamp_ = stamp;
@@ -254,7 +280,7 @@ OdometryTracker::Result OdometryTracker::track(
     if (from_keyframe.translation().norm() > params_.keyframe_translation ||
         pose_math::rotationAngle(from_keyframe) > params_.keyframe_rotation ||
         icp.inlier_fraction < params_.keyframe_min_overlap) {
-      setKeyframe(cloud, intrinsics, observations);
+      setKeyframe(cloud, intrinsics, observations, frameIntensity());
       new_keyframe = true;
     }
   }
@@ -268,7 +294,42 @@ OdometryTracker::Result OdometryTracker::track(
   result.started_from_guess = out.started_from_guess;
   result.started_from_last_pose = out.started_from_last_pose;
   result.T_odom_predicted = prediction;
+  result.photometric = std::move(out.photometric);
   return result;
+}
+
+bool OdometryTracker::refinePhotometrically(const Cloud& cloud, const CameraIntrinsics& intrinsics,
+                                            const IntensityPyramid& intensity,
+                                            PointToPlaneIcp::Result& icp,
+                                            PhotometricRefinement::Result& out) const {
+  if (icp.status != TrackingStatus::kDegenerate || intensity.empty() || keyframe_intensity_.empty())
+    return false;
+  // ICP puts degenerate_variance along the directions it could not constrain.
+  const PhotometricRefinement::Directions free =
+      freeDirections(icp.covariance, params_.icp.degenerate_variance, 0.5);
+  out = photometric_.refine(keyframe_intensity_, intensity, cloud, intrinsics,
+                            icp.T_reference_current, free);
+  if (!out.refined)
+    return false;
+  // The covariance: the depth's on the constrained directions, the intensities' along the free
+  // ones (both left perturbations in the keyframe frame).
+  const Matrix6 along_free = free * free.transpose();
+  const Matrix6 constrained = Matrix6::Identity() - along_free;
+  const Eigen::MatrixXd information = params_.photometric_information_scale * out.information;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(information);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
+    out.refined = false;
+    out.message = "the intensities' information is singular";
+    out.T_reference_current = icp.T_reference_current;
+    return false;
+  }
+  const Eigen::MatrixXd free_covariance =
+      ldlt.solve(Eigen::MatrixXd::Identity(information.rows(), information.cols()));
+  icp.covariance =
+      constrained * icp.covariance * constrained + free * free_covariance * free.transpose();
+  icp.covariance = 0.5 * (icp.covariance + icp.covariance.transpose());
+  icp.T_reference_current = out.T_reference_current;
+  return true;
 }
 
 }  // namespace quadric_slam

@@ -71,6 +71,17 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "increment_covariance_scale", params.increment_covariance_scale, log);
   readParam(reader, "increment_translation_fraction", params.increment_translation_fraction, log);
   readParam(reader, "increment_rotation_per_metre", params.increment_rotation_per_metre, log);
+  readParam(reader, "photometric_refinement", params.photometric_refinement, log);
+  readParam(reader, "photometric_information_scale", params.photometric_information_scale, log);
+  PhotometricRefinement::Params& photometric = params.photometric;
+  readParam(reader, "photometric_levels", photometric.levels, log);
+  readParam(reader, "photometric_max_iterations", photometric.max_iterations, log);
+  readParam(reader, "photometric_max_points", photometric.max_points, log);
+  readParam(reader, "photometric_min_gradient", photometric.min_gradient, log);
+  readParam(reader, "photometric_huber", photometric.huber, log);
+  readParam(reader, "photometric_min_points", photometric.min_points, log);
+  readParam(reader, "photometric_max_translation", photometric.max_translation, log);
+  readParam(reader, "photometric_max_rotation", photometric.max_rotation, log);
   params.validate();
 }
 

@@ -120,6 +120,7 @@ void QuadricSlam::frontEnd(const RgbdFrame& frame, FrontEndFrame* out) const {
   out->intrinsics = frame.intrinsics;
   out->problem.clear();
   out->colour_problem.clear();
+  out->rgb = frame.rgb;
   out->segmentation = Segmentation();
   out->measurements = FrameMeasurements();
   out->normals_ms = out->segmentation_ms = 0.0;
@@ -190,7 +191,8 @@ SlamFrameResult QuadricSlam::backEnd(FrontEndFrame* front) {
     if (params_.mapping_enabled)
       odometry_.adoptSurfaceNormals(out.measurements.observations, cloud_);
     return odometry_.track(cloud_, k, front->stamp,
-                           params_.mapping_enabled ? &out.measurements.observations : nullptr);
+                           params_.mapping_enabled ? &out.measurements.observations : nullptr,
+                           front->rgb.empty() ? nullptr : &front->rgb);
   });
   out.tracking = odometry_.initialized();
   if (!params_.mapping_enabled || !out.tracking)

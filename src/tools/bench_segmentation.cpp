@@ -22,11 +22,11 @@
 
 #include "quadric_slam/frontend/cgal_shape_detector.h"
 #include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/sim/primitive_scene_renderer.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
+#include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/io/segmentation_input.h"
 #include "quadric_slam/pipeline/segmenter_params.h"
-#include "quadric_slam/io/frame_source.h"
+#include "quadric_slam/sim/primitive_scene_renderer.h"
 #include "quadric_slam/sim/scene_yaml.h"
 #include "quadric_slam/sim/synthetic_frame_source.h"
 
@@ -118,9 +118,8 @@ std::vector<Frame> kitchenFrames(const std::string& data, int every,
     if (i++ % every != 0)
       continue;
     const std::string file = line.substr(line.find(' ') + 1);
-    frames.push_back(
-        {"kitchen_" + std::to_string(i - 1),
-         normals.compute(qs::loadOrganizedCloud((dir / file).string(), k, 5000.0))});
+    frames.push_back({"kitchen_" + std::to_string(i - 1),
+                      normals.compute(qs::loadOrganizedCloud((dir / file).string(), k, 5000.0))});
   }
   return frames;
 }
@@ -141,9 +140,9 @@ std::vector<Frame> harshFrames(const std::vector<std::string>& scenes, int count
     qs::RgbdFrame frame;
     while (source.next(frame)) {
       const qs::DepthImageView<float> view = qs::depthViewOf(frame.depth_m);
-      frames.push_back({fs::path(path).stem().string() + "_" + std::to_string(frames.size()),
-                        normals.compute(qs::backProject(view, frame.intrinsics,
-                                                        qs::BackProjectionParams()))});
+      frames.push_back(
+          {fs::path(path).stem().string() + "_" + std::to_string(frames.size()),
+           normals.compute(qs::backProject(view, frame.intrinsics, qs::BackProjectionParams()))});
     }
   }
   return frames;
@@ -243,7 +242,8 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: bench_segmentation [--data DIR] [--repeats N] [--synthetic N] "
-                   "[--baseline-frames N] [--kitchen-every K] [--harsh N] [--config segmentation.yaml] [--set KEY=VALUE]...\n");
+                   "[--baseline-frames N] [--kitchen-every K] [--harsh N] [--config "
+                   "segmentation.yaml] [--set KEY=VALUE]...\n");
       return 2;
     }
   }
@@ -264,10 +264,12 @@ int main(int argc, char** argv) {
   // Segments per frame, per set: planes and curved (sphere, cylinder, cone, general).
   struct Counts {
     double frames = 0, planes = 0, curved = 0, ransac_points = 0, candidates = 0;
+    // Per-frame stage times of this set; "other" is the frame's time outside the five stages.
+    std::vector<double> planes_ms, ransac_ms, verify_ms, upsample_ms, boundary_ms, other_ms;
   };
   Counts real_counts, kitchen_counts, harsh_counts, synth_counts;
-  std::vector<double> real_ms, kitchen_ms, harsh_ms, synth_ms, all_ms, planes_ms, ransac_ms, verify_ms, upsample_ms,
-      boundary_ms;
+  std::vector<double> real_ms, kitchen_ms, harsh_ms, synth_ms, all_ms, planes_ms, ransac_ms,
+      verify_ms, upsample_ms, boundary_ms;
   for (int r = 0; r < repeats; ++r) {
     for (const auto* set : {&real, &kitchen, &harsh_frames, &synth}) {
       for (const Frame& f : *set) {
@@ -288,6 +290,14 @@ int main(int argc, char** argv) {
         counts.candidates += s.timings.ransac_candidates;
         for (const qs::QuadricDetection& d : s.detections)
           (d.shape.quadric_class == qs::QuadricClass::kPlane ? counts.planes : counts.curved) += 1;
+        const qs::SegmentationTimings& st = s.timings;
+        counts.planes_ms.push_back(st.planes_ms);
+        counts.ransac_ms.push_back(st.ransac_ms);
+        counts.verify_ms.push_back(st.verify_ms);
+        counts.upsample_ms.push_back(st.upsample_ms);
+        counts.boundary_ms.push_back(st.boundary_ms);
+        counts.other_ms.push_back(t - st.planes_ms - st.ransac_ms - st.verify_ms - st.upsample_ms -
+                                  st.boundary_ms);
         all_ms.push_back(t);
         planes_ms.push_back(s.timings.planes_ms);
         ransac_ms.push_back(s.timings.ransac_ms);
@@ -299,8 +309,9 @@ int main(int argc, char** argv) {
   }
   std::vector<double> base_ms;
   std::size_t base_shapes = 0;
-  const std::size_t step = std::max<std::size_t>(
-      1, (real.size() + kitchen.size() + harsh_frames.size() + synth.size()) / std::max(1, baseline_frames));
+  const std::size_t step =
+      std::max<std::size_t>(1, (real.size() + kitchen.size() + harsh_frames.size() + synth.size()) /
+                                   std::max(1, baseline_frames));
   std::vector<const Frame*> everything;
   for (const auto& f : real)
     everything.push_back(&f);
@@ -329,13 +340,26 @@ int main(int argc, char** argv) {
   report("    stage: upsampling", upsample_ms);
   report("    stage: boundary", boundary_ms);
   for (const auto& [name, c] : {std::pair<const char*, Counts>{"real", real_counts},
-                                {"kitchen", kitchen_counts}, {"harsh", harsh_counts},
+                                {"kitchen", kitchen_counts},
+                                {"harsh", harsh_counts},
                                 {"synthetic", synth_counts}})
     if (c.frames > 0)
-      std::printf("  per frame, %-9s  segments: planes %5.1f  curved %5.1f;  RANSAC input %6.0f "
-                  "points, %5.1f candidates\n",
-                  name, c.planes / c.frames, c.curved / c.frames, c.ransac_points / c.frames,
-                  c.candidates / c.frames);
+      std::printf(
+          "  per frame, %-9s  segments: planes %5.1f  curved %5.1f;  RANSAC input %6.0f "
+          "points, %5.1f candidates\n",
+          name, c.planes / c.frames, c.curved / c.frames, c.ransac_points / c.frames,
+          c.candidates / c.frames);
+  for (const auto& [name, c] : {std::pair<const char*, Counts>{"real", real_counts},
+                                {"kitchen", kitchen_counts},
+                                {"harsh", harsh_counts},
+                                {"synthetic", synth_counts}})
+    if (c.frames > 0)
+      std::printf(
+          "  stage medians, %-9s planes %4.1f  ransac %4.1f  verification %4.1f  "
+          "upsampling %4.1f  boundary %4.1f  other %4.1f ms\n",
+          name, percentile(c.planes_ms, 0.5), percentile(c.ransac_ms, 0.5),
+          percentile(c.verify_ms, 0.5), percentile(c.upsample_ms, 0.5),
+          percentile(c.boundary_ms, 0.5), percentile(c.other_ms, 0.5));
   if (!base_ms.empty()) {
     std::printf("Baseline, CGAL Efficient RANSAC, 4 shapes, full frame (%zu shapes total):\n",
                 base_shapes);

@@ -8,6 +8,9 @@
 
 #include <vector>
 
+#include <opencv2/core.hpp>
+
+#include "quadric_slam/odometry/photometric_refinement.h"
 #include "quadric_slam/odometry/point_to_plane_icp.h"
 #include "quadric_slam/odometry/quadric_motion_guess.h"
 #include "quadric_slam/odometry/surface_normals.h"
@@ -85,6 +88,15 @@ class OdometryTracker {
     double increment_covariance_scale = 4.0;
     double increment_translation_fraction = 0.05;
     double increment_rotation_per_metre = 0.05;
+    // When track() is given the frame's image (registered to the depth): a degenerate alignment is
+    // refined along the directions the depth left free by the intensities
+    // (odometry/photometric_refinement.h), and its covariance there becomes the intensities'
+    // (their information times photometric_information_scale, (0, 1]: the pixels' errors are
+    // correlated and the brightness is not constant, so the raw figure is over-confident). Such a
+    // step stays degenerate but, when refined, sets the velocity of the prior like an ok one.
+    bool photometric_refinement = false;
+    PhotometricRefinement::Params photometric;
+    double photometric_information_scale = 0.1;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -116,6 +128,8 @@ class OdometryTracker {
     // The constant-velocity prior's prediction of this frame's pose (the last pose when no
     // confirmed velocity is held; identity for the first frame).
     Eigen::Isometry3d T_odom_predicted = Eigen::Isometry3d::Identity();
+    // The intensities' refinement of a degenerate alignment (refined = false when not made).
+    PhotometricRefinement::Result photometric;
   };
 
   explicit OdometryTracker(const Params& params);
@@ -126,8 +140,11 @@ class OdometryTracker {
   // the cloud's size does not fit the intrinsics; bad data otherwise gives status lost.
   // observations: the frame's quadric observations (camera frame), for the motion guess; nullptr
   // tracks from the constant-velocity prior alone.
+  // image: the frame's 8-bit grey or colour image registered to the depth at the intrinsics'
+  // size, for Params::photometric_refinement (nullptr, or another size: depth alone).
   Result track(const Cloud& cloud, const CameraIntrinsics& intrinsics, double stamp,
-               const std::vector<QuadricMeasurement>* observations = nullptr);
+               const std::vector<QuadricMeasurement>* observations = nullptr,
+               const cv::Mat* image = nullptr);
 
   // Gives the points of cloud that lie on the frame's observed surfaces the surfaces' normals
   // (Params::surface_normals; odometry/surface_normals.h), on the grid the ICP reads (every
@@ -143,8 +160,15 @@ class OdometryTracker {
   const Params& params() const { return params_; }
 
  private:
+  // intensity: the frame's pyramid (moved into the keyframe's; empty when none).
   void setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics,
-                   const std::vector<QuadricMeasurement>* observations);
+                   const std::vector<QuadricMeasurement>* observations,
+                   IntensityPyramid& intensity);
+  // Refines a degenerate alignment along its free directions by the intensities (Params::
+  // photometric_refinement); returns whether the pose changed.
+  bool refinePhotometrically(const Cloud& cloud, const CameraIntrinsics& intrinsics,
+                             const IntensityPyramid& intensity, PointToPlaneIcp::Result& icp,
+                             PhotometricRefinement::Result& out) const;
   // ICP from the prior, from the last pose and from the surfaces' guess when they differ from the
   // prior; the best of them.
   PointToPlaneIcp::Result alignFromBestStart(const Cloud& cloud,
@@ -162,6 +186,8 @@ class OdometryTracker {
   Params params_;
   PointToPlaneIcp icp_;
   QuadricMotionGuesser guesser_;
+  PhotometricRefinement photometric_;
+  IntensityPyramid keyframe_intensity_;          // empty when the keyframe came without an image
   SurfaceNormalScratch surface_normal_scratch_;  // adoptSurfaceNormals' buffers, kept
   // The keyframe's observations without their supporting points (empty when none were given).
   std::vector<QuadricMeasurement> keyframe_observations_;

@@ -27,9 +27,10 @@ void readNormalEstimationParams(const ParamReader& reader, BackProjectionParams&
 // min_correspondences, min_eigenvalue_ratio, noise_information_factor, noise_information_min_depth,
 // degenerate_variance, max_translation_from_guess, max_rotation_from_guess, keyframe_translation,
 // keyframe_rotation, keyframe_min_overlap, constant_velocity, velocity_hold_time,
-// velocity_min_information, lost_frames_before_new_keyframe, the motion guess (guess_*) and the increment covariance's
-// calibration (increment_covariance_scale, increment_translation_fraction,
-// increment_rotation_per_metre).
+// velocity_min_information, lost_frames_before_new_keyframe, the motion guess (guess_*) and the
+// increment covariance's calibration (increment_covariance_scale, increment_translation_fraction,
+// increment_rotation_per_metre), and the photometric refinement of degenerate alignments
+// (photometric_refinement, photometric_information_scale, photometric_*).
 void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& params, ParamLog& log);
 
 // config/mapping.yaml: the mapper (candidates, association gate, sliding window, keyframes,
@@ -39,10 +40,10 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
                        QuadricReconstruction::Params& reconstruction, ParamLog& log);
 
 // config/mapping.yaml, what the map does after a loss of tracking (mapping/tracking_recovery.h):
-// recovery_min_landmark_associations, recovery_confirm_frames, recovery_min_map_landmarks, recovery_max_frames;
-// and the relocalisation against the map while recovering (mapping/relocaliser.h):
-// relocalisation_enabled, relocalisation_min_supporting_surfaces, relocalisation_max_ambiguity,
-// relocalisation_extent_margin, relocalisation_min_plane_points,
+// recovery_min_landmark_associations, recovery_confirm_frames, recovery_min_map_landmarks,
+// recovery_max_frames; and the relocalisation against the map while recovering
+// (mapping/relocaliser.h): relocalisation_enabled, relocalisation_min_supporting_surfaces,
+// relocalisation_max_ambiguity, relocalisation_extent_margin, relocalisation_min_plane_points,
 // relocalisation_max_angle_difference, relocalisation_max_offset_difference.
 void readTrackingRecoveryParams(const ParamReader& reader, TrackingRecovery::Params& params,
                                 ParamLog& log);

@@ -117,6 +117,7 @@ struct FrontEndFrame {
   std::string problem;  // not empty: the frame cannot be used (the back end skips it, saying why)
   std::string colour_problem;  // not empty: the RGB image could not colour the supporting points
   pcl::PointCloud<pcl::PointNormal> cloud;  // organized, with normals (camera frame)
+  cv::Mat rgb;  // the frame's RGB image (shared, not copied), or empty: the odometry's intensities
   Segmentation segmentation;
   FrameMeasurements measurements;
   double normals_ms = 0.0, segmentation_ms = 0.0;  // timed stages (segmentation 0 when not run)

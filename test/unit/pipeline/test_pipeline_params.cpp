@@ -87,6 +87,11 @@ TEST(PipelineParams, OdometryYamlKeysAreAllRead) {
                    file["increment_translation_fraction"].as<double>());
   EXPECT_DOUBLE_EQ(params.increment_rotation_per_metre,
                    file["increment_rotation_per_metre"].as<double>());
+  EXPECT_EQ(params.photometric_refinement, file["photometric_refinement"].as<bool>());
+  EXPECT_EQ(params.photometric.levels, file["photometric_levels"].as<int>());
+  EXPECT_DOUBLE_EQ(params.photometric.huber, file["photometric_huber"].as<double>());
+  EXPECT_DOUBLE_EQ(params.photometric.max_translation,
+                   file["photometric_max_translation"].as<double>());
 }
 
 TEST(PipelineParams, MappingYamlKeysAreAllRead) {

@@ -1,0 +1,249 @@
+// The intensities' refinement of a depth alignment along its free directions
+// (odometry/photometric_refinement.h): a textured wall seen from two poses that differ along the
+// wall, which depth alone cannot tell apart.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <opencv2/core.hpp>
+
+#include "quadric_slam/odometry/odometry_tracker.h"
+#include "quadric_slam/odometry/photometric_refinement.h"
+#include "quadric_slam/odometry/pose_math.h"
+#include "synthetic_scene.h"
+
+namespace quadric_slam {
+namespace {
+
+using synthetic::vgaIntrinsics;
+
+// A wall at Z = wall_z of the reference frame, textured by smooth waves of a few centimetres to
+// decimetres (grey levels).
+constexpr double kWallZ = 2.0;
+double texture(double X, double Y) {
+  return 128 + 40 * std::sin(9 * X) + 35 * std::cos(7 * Y) + 20 * std::sin(31 * (X + 0.5 * Y)) +
+         15 * std::cos(23 * X - 17 * Y);
+}
+
+struct View {
+  cv::Mat image;                            // CV_8UC1
+  pcl::PointCloud<pcl::PointNormal> cloud;  // organized, camera frame
+};
+
+// The wall seen by a camera at T_reference_camera; uniform: a wall without texture.
+View render(const Eigen::Isometry3d& T_reference_camera, bool uniform = false) {
+  const CameraIntrinsics k = vgaIntrinsics();
+  View view;
+  view.image = cv::Mat(k.height, k.width, CV_8UC1);
+  view.cloud = pcl::PointCloud<pcl::PointNormal>(k.width, k.height);
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d ray((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+      const Eigen::Vector3d direction = T_reference_camera.linear() * ray;
+      const double s = (kWallZ - T_reference_camera.translation().z()) / direction.z();
+      const Eigen::Vector3d X = T_reference_camera.translation() + s * direction;
+      const double grey = uniform ? 128.0 : texture(X.x(), X.y());
+      view.image.at<std::uint8_t>(v, u) = cv::saturate_cast<std::uint8_t>(std::round(grey));
+      pcl::PointNormal& q = view.cloud(u, v);
+      const Eigen::Vector3d P = s * ray;
+      q.x = static_cast<float>(P.x());
+      q.y = static_cast<float>(P.y());
+      q.z = static_cast<float>(P.z());
+      const Eigen::Vector3d n = -T_reference_camera.linear().transpose().col(2);
+      q.normal_x = static_cast<float>(n.x());
+      q.normal_y = static_cast<float>(n.y());
+      q.normal_z = static_cast<float>(n.z());
+    }
+  }
+  return view;
+}
+
+// A wall facing the camera leaves free the translations along it and the turn about its normal.
+PhotometricRefinement::Directions alongTheWall() {
+  PhotometricRefinement::Directions free = PhotometricRefinement::Directions::Zero(6, 3);
+  free(0, 0) = 1;  // v_x
+  free(1, 1) = 1;  // v_y
+  free(5, 2) = 1;  // omega_z
+  return free;
+}
+
+Eigen::Isometry3d motionAlongTheWall(double x, double y, double turn) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(turn, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(x, y, 0);
+  return T;
+}
+
+// The refinement of the current view's pose from start along the wall's free directions.
+PhotometricRefinement::Result refineAlongTheWall(
+    const View& reference, const View& current, const Eigen::Isometry3d& start,
+    const PhotometricRefinement::Params& params = PhotometricRefinement::Params()) {
+  const PhotometricRefinement refinement(params);
+  return refinement.refine(IntensityPyramid::fromImage(reference.image, params.levels),
+                           IntensityPyramid::fromImage(current.image, params.levels), current.cloud,
+                           vgaIntrinsics(), start, alongTheWall());
+}
+
+TEST(PhotometricRefinement, RecoversAMotionAlongATexturedWallFromTheDepthAlignment) {
+  const Eigen::Isometry3d truth = motionAlongTheWall(0.03, -0.02, 0.01);
+  const View reference = render(Eigen::Isometry3d::Identity());
+  const View current = render(truth);
+  // The depth alignment stopped where it started along the wall (at the reference pose).
+  const PhotometricRefinement::Result result =
+      refineAlongTheWall(reference, current, Eigen::Isometry3d::Identity());
+  ASSERT_TRUE(result.refined) << result.message;
+  const Eigen::Isometry3d error = truth.inverse() * result.T_reference_current;
+  EXPECT_LT(error.translation().norm(), 0.002);
+  EXPECT_LT(pose_math::rotationAngle(error), 0.001);
+  EXPECT_LT(result.rms_after, 0.5 * result.rms_before);
+  EXPECT_GE(result.points, PhotometricRefinement::Params().min_points);
+  ASSERT_EQ(result.information.rows(), 3);
+  EXPECT_GT(result.information.determinant(), 0);
+}
+
+TEST(PhotometricRefinement, KeepsTheConstrainedDirectionsOfTheStart) {
+  const Eigen::Isometry3d truth = motionAlongTheWall(0.02, 0.015, -0.008);
+  const View reference = render(Eigen::Isometry3d::Identity());
+  const View current = render(truth);
+  // The start is off the truth along the wall's normal by 5 mm; only the free directions move.
+  Eigen::Isometry3d start = Eigen::Isometry3d::Identity();
+  start.translation().z() = 0.005;
+  const PhotometricRefinement::Result result = refineAlongTheWall(reference, current, start);
+  ASSERT_TRUE(result.refined) << result.message;
+  EXPECT_NEAR(result.T_reference_current.translation().z(), 0.005, 1e-9);
+  const Eigen::Vector3d axis = Eigen::AngleAxisd(result.T_reference_current.linear()).axis();
+  EXPECT_GT(std::abs(axis.z()), 1 - 1e-9);  // turned about the wall's normal only
+  EXPECT_NEAR(result.T_reference_current.translation().x(), 0.02, 0.004);
+  EXPECT_NEAR(result.T_reference_current.translation().y(), 0.015, 0.004);
+}
+
+TEST(PhotometricRefinement, AWallWithoutTextureLeavesTheStart) {
+  const View reference = render(Eigen::Isometry3d::Identity(), true);
+  const View current = render(motionAlongTheWall(0.03, 0.0, 0.0), true);
+  const PhotometricRefinement::Result result =
+      refineAlongTheWall(reference, current, Eigen::Isometry3d::Identity());
+  EXPECT_FALSE(result.refined);
+  EXPECT_NE(result.message.find("too few textured pixels"), std::string::npos) << result.message;
+  EXPECT_TRUE(result.T_reference_current.isApprox(Eigen::Isometry3d::Identity()));
+}
+
+TEST(PhotometricRefinement, ARefinementBeyondItsLimitIsRefused) {
+  const View reference = render(Eigen::Isometry3d::Identity());
+  const View current = render(motionAlongTheWall(0.04, 0.0, 0.0));
+  PhotometricRefinement::Params params;
+  params.max_translation = 0.01;  // the true 4 cm are beyond what may be taken
+  const PhotometricRefinement::Result result =
+      refineAlongTheWall(reference, current, Eigen::Isometry3d::Identity(), params);
+  EXPECT_FALSE(result.refined);
+  EXPECT_NE(result.message.find("too far"), std::string::npos) << result.message;
+  EXPECT_TRUE(result.T_reference_current.isApprox(Eigen::Isometry3d::Identity()));
+}
+
+// A camera sliding along a textured wall at 1 cm a frame: the depth alone stays degenerate along
+// the wall; with the images the tracker follows the slide.
+double slideError(bool photometric, int* refined_frames) {
+  OdometryTracker::Params params;
+  params.photometric_refinement = photometric;
+  OdometryTracker tracker(params);
+  *refined_frames = 0;
+  Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 20; ++i) {
+    truth.translation() = Eigen::Vector3d(0.01 * i, 0.004 * i, 0.0);
+    const View view = render(truth);
+    const OdometryTracker::Result result =
+        tracker.track(view.cloud, vgaIntrinsics(), i / 30.0, nullptr, &view.image);
+    if (i > 0)  // (the first frame starts the odom frame: ok)
+      EXPECT_EQ(result.status, TrackingStatus::kDegenerate) << "a wall constrains 3 directions";
+    *refined_frames += result.photometric.refined ? 1 : 0;
+  }
+  return (tracker.pose().translation() - truth.translation()).norm();
+}
+
+TEST(OdometryTrackerPhotometric, FollowsASlideAlongATexturedWallThatTheDepthCannotSee) {
+  int refined = 0;
+  const double with_images = slideError(true, &refined);
+  EXPECT_LT(with_images, 0.005);
+  EXPECT_GE(refined, 15);
+  const double depth_alone = slideError(false, &refined);
+  EXPECT_EQ(refined, 0);
+  EXPECT_GT(depth_alone, 0.05);  // 20 cm of slide, most of it unmeasured
+}
+
+TEST(PhotometricRefinement, IntensityJacobianMatchesNumericDifferentiation) {
+  // An image known in closed form: I(x, y) and its gradient at any point.
+  const double fx = 525, fy = 520, cx = 319.5, cy = 239.5;
+  const auto image = [](double x, double y) {
+    return 100 + 30 * std::sin(0.05 * x) + 20 * std::cos(0.08 * y) + 0.01 * x * y;
+  };
+  const auto gradient = [](double x, double y) {
+    return Eigen::Vector2d(1.5 * std::cos(0.05 * x) + 0.01 * y,
+                           -1.6 * std::sin(0.08 * y) + 0.01 * x);
+  };
+  const auto intensityAt = [&](const Eigen::Vector3d& P) {
+    return image(fx * P.x() / P.z() + cx, fy * P.y() / P.z() + cy);
+  };
+  for (const Eigen::Vector3d& P : {Eigen::Vector3d(0.3, -0.2, 2.0), Eigen::Vector3d(-1.1, 0.4, 3.5),
+                                   Eigen::Vector3d(0.05, 0.6, 0.9)}) {
+    const Eigen::Vector2d g = gradient(fx * P.x() / P.z() + cx, fy * P.y() / P.z() + cy);
+    const Eigen::Matrix<double, 1, 6> J = intensityJacobian(P, g.x(), g.y(), fx, fy);
+    for (int i = 0; i < 6; ++i) {
+      const double h = 1e-6;
+      Vector6d xi = Vector6d::Zero();
+      xi(i) = h;
+      const Eigen::Vector3d plus = pose_math::retractLeft(xi, Eigen::Isometry3d::Identity()) * P;
+      xi(i) = -h;
+      const Eigen::Vector3d minus = pose_math::retractLeft(xi, Eigen::Isometry3d::Identity()) * P;
+      const double numeric = (intensityAt(plus) - intensityAt(minus)) / (2 * h);
+      EXPECT_NEAR(J(i), numeric, 1e-4 * std::max(1.0, std::abs(numeric)))
+          << "column " << i << " at " << P.transpose();
+    }
+  }
+}
+
+TEST(PhotometricRefinement, FreeDirectionsAreTheCovariancesDegenerateOnes) {
+  // sigma^2 H^-1 small on four directions, degenerate_variance on two mixed ones.
+  Matrix6d Q = Matrix6d::Identity();
+  const Eigen::Matrix<double, 6, 6> R =
+      Eigen::HouseholderQR<Matrix6d>(Matrix6d::Random()).householderQ();
+  Vector6d variances;
+  variances << 1e-6, 2e-6, 1e-5, 4e-6, 100, 100;
+  Q = R * variances.asDiagonal() * R.transpose();
+  const PhotometricRefinement::Directions free = freeDirections(Q, 100, 0.5);
+  ASSERT_EQ(free.cols(), 2);
+  // The span of the two found equals the span of R's last two columns.
+  const Matrix6d projector = free * free.transpose();
+  EXPECT_LT((projector * R.col(4) - R.col(4)).norm(), 1e-9);
+  EXPECT_LT((projector * R.col(5) - R.col(5)).norm(), 1e-9);
+  EXPECT_LT((projector * R.col(0)).norm(), 1e-9);
+  EXPECT_EQ(freeDirections(Matrix6d::Identity() * 1e-4, 100, 0.5).cols(), 0);
+}
+
+TEST(IntensityPyramid, HalvesEachLevelAndMeasuresGradientsPerPixel) {
+  cv::Mat ramp(64, 80, CV_8UC1);
+  for (int v = 0; v < ramp.rows; ++v)
+    for (int u = 0; u < ramp.cols; ++u)
+      ramp.at<std::uint8_t>(v, u) = static_cast<std::uint8_t>(2 * u + v);
+  const IntensityPyramid pyramid = IntensityPyramid::fromImage(ramp, 3);
+  ASSERT_EQ(pyramid.intensity.size(), 3u);
+  EXPECT_EQ(pyramid.intensity[2].cols, 20);
+  EXPECT_EQ(pyramid.intensity[2].rows, 16);
+  // Inside the image the ramp rises 2 grey levels a pixel in u, 1 in v (level 0), twice that at
+  // level 1.
+  EXPECT_NEAR(pyramid.gradient_x[0].at<float>(30, 40), 2.0, 1e-5);
+  EXPECT_NEAR(pyramid.gradient_y[0].at<float>(30, 40), 1.0, 1e-5);
+  EXPECT_NEAR(pyramid.gradient_x[1].at<float>(15, 20), 4.0, 1e-4);
+  EXPECT_THROW(IntensityPyramid::fromImage(cv::Mat(10, 10, CV_16UC1), 2), std::invalid_argument);
+  EXPECT_THROW(IntensityPyramid::fromImage(ramp, 0), std::invalid_argument);
+}
+
+TEST(PhotometricRefinement, ParamsOutsideTheirRangesAreRefused) {
+  PhotometricRefinement::Params params;
+  params.huber = 0;
+  EXPECT_THROW(PhotometricRefinement{params}, std::invalid_argument);
+  params = PhotometricRefinement::Params();
+  params.min_points = params.max_points + 1;
+  EXPECT_THROW(PhotometricRefinement{params}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace quadric_slam
