@@ -299,14 +299,8 @@ class MappingNodelet : public nodelet::Nodelet {
         std::lock_guard<std::mutex> lock(stats_mutex_);
         ++stats_.rgb_images;
       }
-      std::string problem = cameraInfoProblem(*info);
       ColourImageBuffer::Entry entry;
-      if (problem.empty())
-        problem = colourImageToRgb(image, &entry.rgb);
-      if (problem.empty() && (info->width != image->width || info->height != image->height))
-        problem = "rgb/camera_info is for " + std::to_string(info->width) + "x" +
-                  std::to_string(info->height) + " images, the image is " +
-                  std::to_string(image->width) + "x" + std::to_string(image->height);
+      const std::string problem = colourEntryFromMessages(image, info, &entry);
       if (!problem.empty()) {
         rgb_drops_.report(problem);
         std::lock_guard<std::mutex> lock(stats_mutex_);
@@ -314,8 +308,6 @@ class MappingNodelet : public nodelet::Nodelet {
         stats_.last_rgb_problem = problem;
         return;
       }
-      entry.stamp = image->header.stamp.toSec();
-      entry.intrinsics = intrinsicsFromCameraInfo(*info);
       colour_images_->add(std::move(entry));
     } catch (const std::exception& e) {
       rgb_drops_.report(std::string("unexpected error: ") + e.what());

@@ -9,6 +9,12 @@
 //             QuadricSegmentation, only when ~use_observations: paired with points_normals by
 //             exact stamp, they give the tracker its motion guess for large steps, as in the
 //             offline runner)
+//             rgb/image and rgb/camera_info (sensor_msgs/Image rgb8, bgr8 or mono8 registered to
+//             the depth, through image_transport; only with ~photometric_refinement): each cloud
+//             takes the image nearest its stamp within ~rgb_max_stamp_difference from a buffer of
+//             ~rgb_buffer_size, and a degenerate alignment is refined by its intensities
+//             (odometry/photometric_refinement.h); a cloud whose image has not arrived yet is
+//             tracked on depth alone (counted on /diagnostics), never held back
 // Publishes   odom (nav_msgs/Odometry: pose of ~camera_frame in ~odom_frame with covariance;
 //             while tracking is lost, the last pose with every pose variance 9999: ros/
 //             odometry_status.h; twist: the step from the previous message over dt, with the
@@ -23,6 +29,7 @@
 // A cloud or camera_info it cannot use (see ros/message_validation.h), or a cloud that makes the
 // core throw, gets an error, throttled per reason; dropped clouds are counted on /diagnostics.
 #include <geometry_msgs/TransformStamped.h>
+#include <image_transport/image_transport.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/time_synchronizer.h>
 #include <nav_msgs/Odometry.h>
@@ -45,6 +52,7 @@
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
+#include "quadric_slam/ros/colour_image_buffer.h"
 #include "quadric_slam/ros/conversions.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
@@ -74,6 +82,15 @@ class OdometryNodelet : public nodelet::Nodelet {
       readOdometryParams(reader, params, log);
       readParam(reader, "queue_size", queue_size, log);
       readParam(reader, "use_observations", use_observations_, log);
+      int rgb_buffer_size = 10;
+      readParam(reader, "rgb_buffer_size", rgb_buffer_size, log);
+      readParam(reader, "rgb_max_stamp_difference", rgb_max_stamp_difference_, log);
+      if (params.photometric_refinement) {
+        if (rgb_buffer_size < 1)
+          throw std::invalid_argument("rgb_buffer_size must be >= 1");
+        colour_images_ = std::make_unique<ColourImageBuffer>(
+            static_cast<std::size_t>(rgb_buffer_size), rgb_max_stamp_difference_);
+      }
       if (odom_frame_.empty() || camera_frame_.empty() || odom_frame_ == camera_frame_)
         throw std::invalid_argument("odom_frame and camera_frame must be non-empty and differ");
       if (queue_size < 1)
@@ -92,6 +109,13 @@ class OdometryNodelet : public nodelet::Nodelet {
     cloud_drops_ = std::make_unique<DropReporter>("odometry: dropping cloud", diagnostics_.get());
     info_drops_ = std::make_unique<DropReporter>("odometry: ignoring camera_info", nullptr);
     info_sub_ = nh.subscribe("depth/camera_info", queue_size, &OdometryNodelet::onCameraInfo, this);
+    if (colour_images_) {
+      rgb_drops_ = std::make_unique<DropReporter>("odometry: ignoring colour image", nullptr);
+      image_transport_ = std::make_unique<image_transport::ImageTransport>(nh);
+      rgb_sub_ = image_transport_->subscribeCamera(
+          "rgb/image", static_cast<std::uint32_t>(queue_size), &OdometryNodelet::onRgb, this,
+          image_transport::TransportHints("raw", ros::TransportHints(), private_nh));
+    }
     if (use_observations_) {
       cloud_filter_.subscribe(nh, "points_normals", queue_size);
       // A cloud the segmentation refuses never gets observations, so the pair never forms:
@@ -134,6 +158,44 @@ class OdometryNodelet : public nodelet::Nodelet {
                             observations->header.stamp.toSec());
     }
     track(msg, &frame.observations);
+  }
+
+  // A colour image and its camera_info into the buffer the clouds look their images up in.
+  void onRgb(const sensor_msgs::ImageConstPtr& image, const sensor_msgs::CameraInfoConstPtr& info) {
+    rgb_drops_->guard([&] {
+      ColourImageBuffer::Entry entry;
+      const std::string problem = colourEntryFromMessages(image, info, &entry);
+      if (!problem.empty()) {
+        rgb_drops_->report(problem);
+        return;
+      }
+      colour_images_->add(std::move(entry));
+    });
+  }
+
+  // The colour image of the cloud's stamp, registered to the depth, or nullptr (depth alone).
+  const cv::Mat* imageFor(double stamp, const CameraIntrinsics& depth_intrinsics,
+                          ColourImageBuffer::Entry* entry) {
+    if (!colour_images_)
+      return nullptr;
+    const bool found = colour_images_->nearest(stamp, entry);
+    colour_images_->dropBefore(stamp - rgb_max_stamp_difference_);
+    std::lock_guard<std::mutex> lock(tracking_mutex_);
+    if (!found) {
+      ++frames_without_image_;
+      return nullptr;
+    }
+    if (entry->rgb->image.cols != depth_intrinsics.width ||
+        entry->rgb->image.rows != depth_intrinsics.height) {
+      ++frames_without_image_;
+      NODELET_WARN_THROTTLE(5.0,
+                            "odometry: the colour image is %dx%d, the depth %dx%d: not registered "
+                            "to the depth, tracking on depth alone",
+                            entry->rgb->image.cols, entry->rgb->image.rows, depth_intrinsics.width,
+                            depth_intrinsics.height);
+      return nullptr;
+    }
+    return &entry->rgb->image;
   }
 
   void onCameraInfo(const sensor_msgs::CameraInfoConstPtr& info) {
@@ -189,7 +251,9 @@ class OdometryNodelet : public nodelet::Nodelet {
     // (What the tracker throws is caught by the guard around this callback and counted as a drop.)
     if (observations != nullptr)
       tracker_->adoptSurfaceNormals(*observations, cloud_);
-    const OdometryTracker::Result result = tracker_->track(cloud_, intrinsics, stamp, observations);
+    ColourImageBuffer::Entry image;
+    const OdometryTracker::Result result = tracker_->track(cloud_, intrinsics, stamp, observations,
+                                                           imageFor(stamp, intrinsics, &image));
     if (result.status != TrackingStatus::kOk) {
       NODELET_WARN_THROTTLE(5.0, "odometry: tracking %s: %s", toString(result.status),
                             result.icp.message.c_str());
@@ -198,6 +262,7 @@ class OdometryNodelet : public nodelet::Nodelet {
       std::lock_guard<std::mutex> lock(tracking_mutex_);
       ++frames_;
       counts_[static_cast<int>(result.status)]++;
+      photometric_refined_ += result.photometric.refined ? 1 : 0;
       last_result_ = result;
     }
     if (!tracker_->initialized()) {
@@ -300,6 +365,10 @@ class OdometryNodelet : public nodelet::Nodelet {
     status.add("inlier fraction", result.icp.inlier_fraction);
     status.add("rms residual (m at 1 m)", result.icp.rms_residual);
     status.add("iterations", result.icp.iterations);
+    if (colour_images_) {
+      status.add("refined by intensities", photometric_refined_);
+      status.add("frames without colour image", frames_without_image_);
+    }
   }
 
   std::string odom_frame_ = "odom";
@@ -323,6 +392,13 @@ class OdometryNodelet : public nodelet::Nodelet {
   // Input health (frames processed and dropped, with the reason) beside the tracking status.
   std::unique_ptr<DropReporter> cloud_drops_, info_drops_;
   bool use_observations_ = false;
+  // The colour images for the photometric refinement (only with ~photometric_refinement).
+  std::unique_ptr<ColourImageBuffer> colour_images_;
+  double rgb_max_stamp_difference_ = 0.02;
+  std::unique_ptr<image_transport::ImageTransport> image_transport_;
+  image_transport::CameraSubscriber rgb_sub_;
+  std::unique_ptr<DropReporter> rgb_drops_;
+  long photometric_refined_ = 0, frames_without_image_ = 0;
   ros::Subscriber cloud_sub_, info_sub_;
   using Synchronizer =
       message_filters::TimeSynchronizer<sensor_msgs::PointCloud2, QuadricObservationArray>;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/message_validation.h"
 
 namespace quadric_slam {
@@ -78,6 +79,25 @@ void ColourImageBuffer::clear() {
 std::size_t ColourImageBuffer::size() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return entries_.size();
+}
+
+std::string colourEntryFromMessages(const sensor_msgs::ImageConstPtr& image,
+                                    const sensor_msgs::CameraInfoConstPtr& info,
+                                    ColourImageBuffer::Entry* entry) {
+  std::string problem = info ? cameraInfoProblem(*info) : "no camera_info";
+  ColourImageBuffer::Entry usable;
+  if (problem.empty())
+    problem = colourImageToRgb(image, &usable.rgb);
+  if (problem.empty() && (info->width != image->width || info->height != image->height))
+    problem = "rgb/camera_info is for " + std::to_string(info->width) + "x" +
+              std::to_string(info->height) + " images, the image is " +
+              std::to_string(image->width) + "x" + std::to_string(image->height);
+  if (!problem.empty())
+    return problem;
+  usable.stamp = image->header.stamp.toSec();
+  usable.intrinsics = intrinsicsFromCameraInfo(*info);
+  *entry = std::move(usable);
+  return problem;
 }
 
 }  // namespace quadric_slam

@@ -11,10 +11,10 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <Eigen/Geometry>
-#include <mutex>
 #include <vector>
 
 #include "../unit/odometry/synthetic_scene.h"
+#include "odom_recorder.h"
 
 namespace quadric_slam {
 namespace {
@@ -46,7 +46,6 @@ class OdometryNodeletTest : public ::testing::Test {
   void SetUp() override {
     info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("depth/camera_info", 1, true);
     cloud_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points_normals", 5);
-    odom_sub_ = nh_.subscribe("odom", 100, &OdometryNodeletTest::onOdom, this);
     spinner_.start();
     const CameraIntrinsics k = synthetic::vgaIntrinsics();
     sensor_msgs::CameraInfo info;
@@ -56,31 +55,16 @@ class OdometryNodeletTest : public ::testing::Test {
     info.K = {k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1};
     info_pub_.publish(info);
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(30.0);
-    while ((cloud_pub_.getNumSubscribers() == 0 || odom_sub_.getNumPublishers() == 0) &&
+    while ((cloud_pub_.getNumSubscribers() == 0 || !odom_.hasPublisher()) &&
            ros::WallTime::now() < deadline)
       ros::WallDuration(0.05).sleep();
     ASSERT_GT(cloud_pub_.getNumSubscribers(), 0u) << "the odometry nodelet did not subscribe";
     ros::WallDuration(0.5).sleep();  // let the latched camera_info arrive
   }
 
-  void onOdom(const nav_msgs::OdometryConstPtr& msg) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    odom_.push_back(*msg);
-  }
-
-  std::size_t odomCount() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    return odom_.size();
-  }
-
   // Publishes and waits up to 10 s for the answer; false if none came.
   bool publishAndWait(const sensor_msgs::PointCloud2& cloud, double timeout = 10.0) {
-    const std::size_t before = odomCount();
-    cloud_pub_.publish(cloud);
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(timeout);
-    while (odomCount() == before && ros::WallTime::now() < deadline)
-      ros::WallDuration(0.005).sleep();
-    return odomCount() > before;
+    return odom_.publishAndWait([&] { cloud_pub_.publish(cloud); }, timeout);
   }
 
   static sensor_msgs::PointCloud2 frame(int i, double stamp) {
@@ -96,9 +80,7 @@ class OdometryNodeletTest : public ::testing::Test {
   ros::NodeHandle nh_;
   ros::AsyncSpinner spinner_{1};
   ros::Publisher info_pub_, cloud_pub_;
-  ros::Subscriber odom_sub_;
-  std::mutex mutex_;
-  std::vector<nav_msgs::Odometry> odom_;
+  OdomRecorder odom_{nh_};
 };
 
 TEST_F(OdometryNodeletTest, TracksSequenceDropsBadCloudsAndResetsOnTimeJump) {
@@ -112,10 +94,10 @@ TEST_F(OdometryNodeletTest, TracksSequenceDropsBadCloudsAndResetsOnTimeJump) {
 
   nav_msgs::Odometry last;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    ASSERT_EQ(odom_.size(), static_cast<std::size_t>(frames));
-    last = odom_.back();
-    EXPECT_TRUE(fromMsg(odom_.front().pose.pose).isApprox(Eigen::Isometry3d::Identity(), 1e-9));
+    const std::vector<nav_msgs::Odometry> odom = odom_.messages();
+    ASSERT_EQ(odom.size(), static_cast<std::size_t>(frames));
+    last = odom.back();
+    EXPECT_TRUE(fromMsg(odom.front().pose.pose).isApprox(Eigen::Isometry3d::Identity(), 1e-9));
   }
   EXPECT_EQ(last.header.frame_id, "odom");
   EXPECT_EQ(last.child_frame_id, "camera");
@@ -158,16 +140,12 @@ TEST_F(OdometryNodeletTest, TracksSequenceDropsBadCloudsAndResetsOnTimeJump) {
 
   // Time going backwards (a looping bag): reset, the odom frame restarts at this frame.
   ASSERT_TRUE(publishAndWait(frame(10, t0 - 5.0)));
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    EXPECT_TRUE(fromMsg(odom_.back().pose.pose).isApprox(Eigen::Isometry3d::Identity(), 1e-9));
-  }
+  { EXPECT_TRUE(fromMsg(odom_.last().pose.pose).isApprox(Eigen::Isometry3d::Identity(), 1e-9)); }
   // ... and tracking continues from there.
   ASSERT_TRUE(publishAndWait(frame(11, t0 - 5.0 + 1 / 30.0)));
   {
-    std::lock_guard<std::mutex> lock(mutex_);
     const Eigen::Isometry3d step = pathPose(10).inverse() * pathPose(11);
-    EXPECT_LT((fromMsg(odom_.back().pose.pose).translation() - step.translation()).norm(), 2e-3);
+    EXPECT_LT((fromMsg(odom_.last().pose.pose).translation() - step.translation()).norm(), 2e-3);
   }
 }
 

@@ -58,4 +58,11 @@ class ColourImageBuffer {
   std::deque<Entry> entries_;  // in stamp order
 };
 
+// The buffer entry of a colour image and its camera_info (image_transport's subscribeCamera
+// pair): empty when usable, else the problem (the camera_info's, the image's as
+// colourImageToRgb() says, or their sizes differing); *entry is filled only when usable.
+std::string colourEntryFromMessages(const sensor_msgs::ImageConstPtr& image,
+                                    const sensor_msgs::CameraInfoConstPtr& info,
+                                    ColourImageBuffer::Entry* entry);
+
 }  // namespace quadric_slam

@@ -72,6 +72,10 @@ TEST(PipelineParams, OdometryYamlKeysAreAllRead) {
   qs::readParam(reader, "publish_tf", publish_tf, log);
   qs::readParam(reader, "queue_size", queue_size, log);
   qs::readParam(reader, "use_observations", use_observations, log);
+  int rgb_buffer_size = 0;
+  double rgb_max_stamp_difference = 0;
+  qs::readParam(reader, "rgb_buffer_size", rgb_buffer_size, log);
+  qs::readParam(reader, "rgb_max_stamp_difference", rgb_max_stamp_difference, log);
   for (const auto& entry : file) {
     const std::string key = entry.first.as<std::string>();
     EXPECT_NE(log.str().find("\n  " + key + ": "), std::string::npos)
