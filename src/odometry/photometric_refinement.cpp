@@ -104,21 +104,33 @@ std::vector<PhotometricPoint> levelPoints(const IntensityPyramid& current,
   const cv::Mat& intensity = current.intensity[level];
   const cv::Mat& gx = current.gradient_x[level];
   const cv::Mat& gy = current.gradient_y[level];
+  // Selected by the gradient at the nearest pixel of the level (a read, no interpolation: most
+  // pixels fail the test), keyed by its square.
+  const double min_squared_gradient = params.min_gradient * params.min_gradient;
   std::vector<std::pair<double, PhotometricPoint>> candidates;
   for (std::uint32_t r = 0; r < cloud.height; r += stride) {
+    const double y = (r * decimation + 0.5) / scale - 0.5;
+    const int row = static_cast<int>(std::lround(y));
+    if (row < 0 || row >= intensity.rows)
+      continue;
+    const float* gx_row = gx.ptr<float>(row);
+    const float* gy_row = gy.ptr<float>(row);
     for (std::uint32_t c = 0; c < cloud.width; c += stride) {
-      const pcl::PointNormal& q = cloud(c, r);
-      if (!std::isfinite(q.x) || !std::isfinite(q.y) || !(q.z > 0))
-        continue;
       const double x = (c * decimation + 0.5) / scale - 0.5;
-      const double y = (r * decimation + 0.5) / scale - 0.5;
-      double value = 0, dx = 0, dy = 0;
-      if (!sample(intensity, x, y, value) || !sample(gx, x, y, dx) || !sample(gy, x, y, dy))
+      const int column = static_cast<int>(std::lround(x));
+      if (column < 0 || column >= intensity.cols)
         continue;
-      const double gradient = std::hypot(dx, dy);
-      if (gradient < params.min_gradient)
+      const double squared_gradient =
+          gx_row[column] * gx_row[column] + gy_row[column] * gy_row[column];
+      if (squared_gradient < min_squared_gradient)
         continue;
-      candidates.push_back({gradient, PhotometricPoint{Eigen::Vector3d(q.x, q.y, q.z), value}});
+      const pcl::PointNormal& q = cloud(c, r);
+      double value = 0;
+      if (!std::isfinite(q.x) || !std::isfinite(q.y) || !(q.z > 0) ||
+          !sample(intensity, x, y, value))
+        continue;
+      candidates.push_back(
+          {squared_gradient, PhotometricPoint{Eigen::Vector3d(q.x, q.y, q.z), value}});
     }
   }
   if (static_cast<int>(candidates.size()) > params.max_points) {
