@@ -302,11 +302,11 @@ bool OdometryTracker::refinePhotometrically(const Cloud& cloud, const CameraIntr
                                             const IntensityPyramid& intensity,
                                             PointToPlaneIcp::Result& icp,
                                             PhotometricRefinement::Result& out) const {
-  if (icp.status != TrackingStatus::kDegenerate || intensity.empty() || keyframe_intensity_.empty())
-    return false;
-  // ICP puts degenerate_variance along the directions it could not constrain.
+  // ICP puts degenerate_variance along the directions it could not constrain; sigma^2 H^-1 on the
+  // others is orders of magnitude smaller, so any threshold between them finds the same ones.
+  constexpr double kFreeVarianceFraction = 0.5;
   const PhotometricRefinement::Directions free =
-      freeDirections(icp.covariance, params_.icp.degenerate_variance, 0.5);
+      freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction);
   out = photometric_.refine(keyframe_intensity_, intensity, cloud, intrinsics,
                             icp.T_reference_current, free);
   if (!out.refined)

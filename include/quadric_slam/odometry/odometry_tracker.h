@@ -165,7 +165,8 @@ class OdometryTracker {
                    const std::vector<QuadricMeasurement>* observations,
                    IntensityPyramid& intensity);
   // Refines a degenerate alignment along its free directions by the intensities (Params::
-  // photometric_refinement); returns whether the pose changed.
+  // photometric_refinement); track() calls it only with both pyramids (the frame's and the
+  // keyframe's). Returns whether the pose changed.
   bool refinePhotometrically(const Cloud& cloud, const CameraIntrinsics& intrinsics,
                              const IntensityPyramid& intensity, PointToPlaneIcp::Result& icp,
                              PhotometricRefinement::Result& out) const;
