@@ -24,12 +24,16 @@ QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) 
   return c;
 }
 
-pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNormal>& cloud, int d) {
+pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNormal>& cloud, int d,
+                                            int threads) {
   pcl::PointCloud<pcl::PointNormal> grid(cloud.width / d, cloud.height / d);
   grid.is_dense = false;
-  for (std::uint32_t r = 0; r < grid.height; ++r)
-    for (std::uint32_t c = 0; c < grid.width; ++c)
-      grid(c, r) = cloud(c * d, r * d);
+  // A copy bound by reading the full cloud: rows split over the threads.
+  forEachChunk(static_cast<int>(grid.height), threads, [&](int, int row_begin, int row_end) {
+    for (int r = row_begin; r < row_end; ++r)
+      for (std::uint32_t c = 0; c < grid.width; ++c)
+        grid(c, r) = cloud(c * d, r * d);
+  });
   return grid;
 }
 

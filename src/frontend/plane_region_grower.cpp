@@ -117,7 +117,6 @@ double planePointVariance(double z, const PlaneRegionGrower::Params& params) {
   return kinectDepthVariance(z, params.noise_scale, params.quantisation_factor) + bend * bend;
 }
 
-
 PlaneRegionGrower::PlaneRegionGrower(const Params& params) : params_(params) {
   params_.validate();
 }
@@ -293,6 +292,45 @@ struct PlaneStats {
   double tiltVariance() const { return noiseVariance() / independent() / spread1; }
 };
 
+// Share of the valid points between two coplanar regions that must lie beyond their plane for the
+// camera to be taken as seeing past it (a gap, not a hole or an occluder).
+constexpr double kSeenPastShare = 0.25;
+
+// Whether the camera sees past the plane n.x = d between two regions: along the image line joining
+// their pixel centroids, the valid points of neither region that lie beyond the plane (on the side
+// away from the camera, outside the plane's distance threshold) are at least kSeenPastShare of the
+// valid points there (and at least two). Fragments of one surface are separated by holes in the
+// depth or by nearer objects; two parallel surfaces at nearly the same offset (a table top and the
+// top of a post beside it) by what the camera sees behind them. owner[i] is the region of point i
+// (-1 for none).
+bool seesPastPlaneBetween(const pcl::PointCloud<pcl::PointNormal>& cloud,
+                          const std::vector<int>& owner, int region_a, int region_b,
+                          const Eigen::Vector2d& pixel_a, const Eigen::Vector2d& pixel_b,
+                          const Eigen::Vector3d& n, double d,
+                          const PlaneRegionGrower::Params& params) {
+  const int width = static_cast<int>(cloud.width);
+  const int steps = static_cast<int>(std::ceil((pixel_b - pixel_a).lpNorm<Eigen::Infinity>()));
+  // The camera (origin) is on the side where n.x - d has the sign of -d.
+  const double away = d >= 0 ? 1.0 : -1.0;
+  int tested = 0, beyond = 0, last = -1;
+  for (int k = 1; k < steps; ++k) {
+    const Eigen::Vector2d pixel = pixel_a + (pixel_b - pixel_a) * (static_cast<double>(k) / steps);
+    const int i =
+        static_cast<int>(std::lround(pixel.y())) * width + static_cast<int>(std::lround(pixel.x()));
+    if (i == last || owner[i] == region_a || owner[i] == region_b)
+      continue;
+    last = i;
+    const pcl::PointNormal& q = cloud.points[i];
+    if (!std::isfinite(q.z))
+      continue;
+    ++tested;
+    const double behind = away * (n.dot(pointOf(q)) - d);
+    if (behind > 0 && !withinPlaneThreshold(behind, q.z, params))
+      ++beyond;
+  }
+  return beyond >= 2 && beyond >= kSeenPastShare * tested;
+}
+
 }  // namespace
 
 std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::mergeCoplanar(
@@ -303,6 +341,19 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::mergeCoplanar(
   std::stable_sort(regions.begin(), regions.end(), [](const Region& a, const Region& b) {
     return a.indices.size() > b.indices.size();
   });
+  const int width = static_cast<int>(cloud.width);
+  // Each point's region (a region keeps its id when it absorbs another) and each region's pixel
+  // centroid, for the test of what lies between two regions.
+  std::vector<int> owner(cloud.size(), -1), ids(regions.size());
+  std::vector<Eigen::Vector2d> pixel_centroids(regions.size(), Eigen::Vector2d::Zero());
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    ids[r] = static_cast<int>(r);
+    for (int k : regions[r].indices) {
+      owner[k] = ids[r];
+      pixel_centroids[r] += Eigen::Vector2d(k % width, k / width);
+    }
+    pixel_centroids[r] /= static_cast<double>(regions[r].indices.size());
+  }
   std::vector<PlaneStats> stats(regions.size());
   for (std::size_t r = 0; r < regions.size(); ++r) {
     PlaneStats& st = stats[r];
@@ -343,16 +394,28 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::mergeCoplanar(
     merged.add(b);
     return merged.rms <= params_.merge_rms_factor * std::sqrt(merged.noiseVariance());
   };
+  const auto seesPast = [&](std::size_t i, std::size_t j) {
+    PlaneStats merged = stats[i];
+    merged.add(stats[j]);
+    return seesPastPlaneBetween(cloud, owner, ids[i], ids[j], pixel_centroids[i],
+                                pixel_centroids[j], merged.normal,
+                                merged.normal.dot(merged.centroid), params_);
+  };
   bool merged_any = true;
   while (merged_any) {
     merged_any = false;
     for (std::size_t i = 0; i < regions.size(); ++i) {
       for (std::size_t j = i + 1; j < regions.size();) {
-        if (!coplanar(stats[i], stats[j])) {
+        if (!coplanar(stats[i], stats[j]) || seesPast(i, j)) {
           ++j;
           continue;
         }
         Region& a = regions[i];
+        const double na = static_cast<double>(a.indices.size());
+        const double nb = static_cast<double>(regions[j].indices.size());
+        pixel_centroids[i] = (na * pixel_centroids[i] + nb * pixel_centroids[j]) / (na + nb);
+        for (int k : regions[j].indices)
+          owner[k] = ids[i];
         a.indices.insert(a.indices.end(), regions[j].indices.begin(), regions[j].indices.end());
         PlaneStats& st = stats[i];
         st.add(stats[j]);
@@ -360,6 +423,8 @@ std::vector<PlaneRegionGrower::Region> PlaneRegionGrower::mergeCoplanar(
         a.plane.point = st.centroid;
         regions.erase(regions.begin() + j);
         stats.erase(stats.begin() + j);
+        ids.erase(ids.begin() + j);
+        pixel_centroids.erase(pixel_centroids.begin() + j);
         merged_any = true;
       }
     }

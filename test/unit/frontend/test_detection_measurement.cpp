@@ -9,6 +9,7 @@
 #include <cmath>
 #include <random>
 
+#include "../kinect_vga.h"
 #include "primitive_desk_scene.h"
 #include "quadric_slam/frontend/detection_measurement.h"
 #include "quadric_slam/frontend/normal_estimator.h"
@@ -23,20 +24,10 @@ using qs::QuadricClass;
 
 namespace {
 
-qs::CameraIntrinsics kinect() {
-  qs::CameraIntrinsics k;
-  k.fx = k.fy = 525.0;
-  k.cx = 319.5;
-  k.cy = 239.5;
-  k.width = 640;
-  k.height = 480;
-  return k;
-}
-
 pcl::PointCloud<pcl::PointNormal> cloudWithNormals(const cv::Mat& depth) {
   const qs::DepthImageView<float> view = qs::depthViewOf(depth);
   const pcl::PointCloud<pcl::PointXYZ> cloud =
-      qs::backProject(view, kinect(), qs::BackProjectionParams());
+      qs::backProject(view, qs::test::kinectVga(), qs::BackProjectionParams());
   return qs::NormalEstimator(qs::NormalEstimator::Params()).compute(cloud);
 }
 
@@ -50,8 +41,8 @@ double quadricValue(const qs::QuadricModel& q, const Eigen::Vector3d& p) {
 }  // namespace
 
 TEST(DetectionMeasurement, SegmenterDetectionsBecomeCoreQuadricsWithTheirExtentBoxes) {
-  const qs::PrimitiveRendering frame =
-      qs::renderPrimitives(qs::test::primitiveDeskScene(), kinect(), qs::RenderParams());
+  const qs::PrimitiveRendering frame = qs::renderPrimitives(
+      qs::test::primitiveDeskScene(), qs::test::kinectVga(), qs::RenderParams());
   const pcl::PointCloud<pcl::PointNormal> cloud = cloudWithNormals(frame.depth);
   const qs::Segmentation seg = qs::QuadricSegmenter(qs::QuadricSegmenter::Params()).segment(cloud);
   ASSERT_GE(seg.detections.size(), 5u);

@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 
+#include "../kinect_vga.h"
 #include "primitive_desk_scene.h"
 #include "quadric_slam/frontend/multi_resolution_labels.h"
 #include "quadric_slam/frontend/normal_estimator.h"
@@ -27,20 +28,10 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-qs::CameraIntrinsics kinect() {
-  qs::CameraIntrinsics k;
-  k.fx = k.fy = 525.0;
-  k.cx = 319.5;
-  k.cy = 239.5;
-  k.width = 640;
-  k.height = 480;
-  return k;
-}
-
 pcl::PointCloud<pcl::PointNormal> cloudWithNormals(const cv::Mat& depth) {
   const qs::DepthImageView<float> view = qs::depthViewOf(depth);
   const pcl::PointCloud<pcl::PointXYZ> cloud =
-      qs::backProject(view, kinect(), qs::BackProjectionParams());
+      qs::backProject(view, qs::test::kinectVga(), qs::BackProjectionParams());
   return qs::NormalEstimator(qs::NormalEstimator::Params()).compute(cloud);
 }
 
@@ -70,7 +61,7 @@ void checkScene(const Eigen::Isometry3d& T_camera_scene, unsigned seed,
   const std::vector<qs::ScenePrimitive> scene = qs::test::primitiveDeskScene(T_camera_scene);
   qs::RenderParams render;
   render.seed = seed;
-  const qs::PrimitiveRendering frame = qs::renderPrimitives(scene, kinect(), render);
+  const qs::PrimitiveRendering frame = qs::renderPrimitives(scene, qs::test::kinectVga(), render);
   const qs::QuadricSegmenter segmenter{params};
   const qs::Segmentation result = segmenter.segment(cloudWithNormals(frame.depth));
   // QS_DEBUG_DIR=dir writes the truth and the segmentation as pictures, and lists detections.
@@ -171,8 +162,9 @@ TEST(QuadricSegmenter, FindsThemWithCurvedShapesOnACoarserGrid) {
 namespace {
 
 void checkLabelsConsistent(const qs::QuadricSegmenter::Params& params) {
-  const qs::PrimitiveRendering frame = qs::renderPrimitives(
-      qs::test::primitiveDeskScene(Eigen::Isometry3d::Identity()), kinect(), qs::RenderParams());
+  const qs::PrimitiveRendering frame =
+      qs::renderPrimitives(qs::test::primitiveDeskScene(Eigen::Isometry3d::Identity()),
+                           qs::test::kinectVga(), qs::RenderParams());
   const qs::Segmentation result =
       qs::QuadricSegmenter(params).segment(cloudWithNormals(frame.depth));
   ASSERT_FALSE(result.detections.empty());

@@ -7,22 +7,13 @@
 #include <limits>
 #include <stdexcept>
 
+#include "../kinect_vga.h"
 #include "../real_frames.h"
 #include "quadric_slam/sim/depth_warp.h"
 
 namespace qs = quadric_slam;
 
 namespace {
-
-qs::CameraIntrinsics vga() {
-  qs::CameraIntrinsics k;
-  k.fx = k.fy = 525.0;
-  k.cx = 319.5;
-  k.cy = 239.5;
-  k.width = 640;
-  k.height = 480;
-  return k;
-}
 
 struct RealFrame {
   cv::Mat depth;
@@ -45,7 +36,9 @@ Eigen::Isometry3d motion(const Eigen::Vector3d& t, double angle_deg, const Eigen
   return T;
 }
 
-bool valid(float z) { return std::isfinite(z) && z > 0; }
+bool valid(float z) {
+  return std::isfinite(z) && z > 0;
+}
 
 }  // namespace
 
@@ -70,14 +63,16 @@ TEST(DepthWarp, WarpedPixelsReprojectOntoTheMeasuredSurface) {
       const Eigen::Vector3d p_moved((u - f.k.cx) * z / f.k.fx, (v - f.k.cy) * z / f.k.fy, z);
       const Eigen::Vector3d p = T_ref_moved * p_moved;
       const double ur = f.k.fx * p.x() / p.z() + f.k.cx, vr = f.k.fy * p.y() / p.z() + f.k.cy;
-      const int u0 = static_cast<int>(std::floor(ur + 1e-6)), v0 = static_cast<int>(std::floor(vr + 1e-6));
+      const int u0 = static_cast<int>(std::floor(ur + 1e-6)),
+                v0 = static_cast<int>(std::floor(vr + 1e-6));
       ASSERT_TRUE(u0 >= 0 && v0 >= 0 && u0 < f.depth.cols && v0 < f.depth.rows)
           << "warped pixel " << u << "," << v << " comes from outside the reference image";
       float lo = std::numeric_limits<float>::max(), hi = 0;
       int corners = 0;
       for (int dv = 0; dv <= 1; ++dv)
         for (int du = 0; du <= 1; ++du) {
-          const int uu = std::min(u0 + du, f.depth.cols - 1), vv = std::min(v0 + dv, f.depth.rows - 1);
+          const int uu = std::min(u0 + du, f.depth.cols - 1),
+                    vv = std::min(v0 + dv, f.depth.rows - 1);
           const float zr = f.depth.at<float>(vv, uu);
           if (!valid(zr))
             continue;
@@ -124,10 +119,11 @@ TEST(DepthWarp, IdentityMotionReproducesTheFrame) {
 // is filled in), the square hides the wall behind it (z-buffer), and what lies beyond the
 // reference image's right edge is a hole too.
 TEST(DepthWarp, DisoccludedAreasAreHolesAndNearerSurfacesHideFartherOnes) {
-  const qs::CameraIntrinsics k = vga();
+  const qs::CameraIntrinsics k = qs::test::kinectVga();
   cv::Mat depth(k.height, k.width, CV_32FC1, cv::Scalar(3.0f));
   depth(cv::Rect(280, 200, 81, 81)).setTo(1.0f);  // u 280..360, v 200..280
-  const Eigen::Isometry3d T_ref_moved = motion(Eigen::Vector3d(0.2, 0, 0), 0, Eigen::Vector3d::UnitZ());
+  const Eigen::Isometry3d T_ref_moved =
+      motion(Eigen::Vector3d(0.2, 0, 0), 0, Eigen::Vector3d::UnitZ());
   const cv::Mat w = qs::warpDepthImage(depth, k, T_ref_moved);
 
   for (int v = 205; v <= 275; ++v) {
@@ -145,7 +141,7 @@ TEST(DepthWarp, DisoccludedAreasAreHolesAndNearerSurfacesHideFartherOnes) {
 }
 
 TEST(DepthWarp, RejectsBadInputAndParameters) {
-  const qs::CameraIntrinsics k = vga();
+  const qs::CameraIntrinsics k = qs::test::kinectVga();
   const cv::Mat depth(k.height, k.width, CV_32FC1, cv::Scalar(2.0f));
   qs::DepthWarpParams p;
   p.depth_jump_fraction = 0;
@@ -158,7 +154,7 @@ TEST(DepthWarp, RejectsBadInputAndParameters) {
   EXPECT_THROW(qs::warpDepthImage(cv::Mat(10, 10, CV_32FC1, cv::Scalar(1.0f)), k,
                                   Eigen::Isometry3d::Identity()),
                std::invalid_argument);
-  EXPECT_THROW(qs::warpDepthImage(cv::Mat(k.height, k.width, CV_16UC1), k,
-                                  Eigen::Isometry3d::Identity()),
-               std::invalid_argument);
+  EXPECT_THROW(
+      qs::warpDepthImage(cv::Mat(k.height, k.width, CV_16UC1), k, Eigen::Isometry3d::Identity()),
+      std::invalid_argument);
 }
