@@ -9,39 +9,20 @@
 #include <utility>
 #include <vector>
 
-#include "../kinect_vga.h"
-#include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
-#include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/sim/primitive_scene_renderer.h"
+#include "segment_rendered.h"
 
 namespace qs = quadric_slam;
 using qs::PrimitiveShape;
 
 namespace {
 
-qs::Segmentation segment(const cv::Mat& depth) {
-  const qs::DepthImageView<float> view = qs::depthViewOf(depth);
-  const pcl::PointCloud<pcl::PointXYZ> cloud =
-      qs::backProject(view, qs::test::kinectVga(), qs::BackProjectionParams());
-  const pcl::PointCloud<pcl::PointNormal> with_normals =
-      qs::NormalEstimator(qs::NormalEstimator::Params()).compute(cloud);
-  return qs::QuadricSegmenter(qs::QuadricSegmenter::Params()).segment(with_normals);
-}
-
 // The label covering most of the truth's pixels of primitive t, and the share it covers.
 std::pair<std::uint16_t, double> coveringLabel(const qs::Segmentation& result, const cv::Mat& truth,
                                                int t) {
-  std::vector<int> count(result.detections.size() + 1, 0);
   int total = 0;
-  for (int y = 0; y < truth.rows; ++y)
-    for (int x = 0; x < truth.cols; ++x)
-      if (truth.at<std::uint16_t>(y, x) == t + 1) {
-        ++total;
-        const std::uint16_t label = result.labels.at<std::uint16_t>(y, x);
-        if (label < count.size())
-          ++count[label];
-      }
+  const std::vector<int> count = qs::test::labelCountsOn(result, truth, t, &total);
   std::uint16_t best = 0;
   for (std::uint16_t label = 1; label < count.size(); ++label)
     if (count[label] > count[best] || best == 0)
@@ -79,7 +60,7 @@ void expectTwoPlateSegments(double drop) {
   const std::vector<qs::ScenePrimitive> scene = twoPlates(drop);
   const qs::PrimitiveRendering frame =
       qs::renderPrimitives(scene, qs::test::kinectVga(), qs::RenderParams());
-  const qs::Segmentation result = segment(frame.depth);
+  const qs::Segmentation result = qs::test::segmentRendered(frame.depth);
   const auto [left, left_share] = coveringLabel(result, frame.truth, 1);
   const auto [right, right_share] = coveringLabel(result, frame.truth, 2);
   EXPECT_GE(left_share, 0.8);
@@ -111,7 +92,7 @@ TEST(PlaneMerging, WallFragmentsBesideANearerPoleAreOneSegment) {
   const std::vector<qs::ScenePrimitive> scene = wallBehindPole();
   const qs::PrimitiveRendering frame =
       qs::renderPrimitives(scene, qs::test::kinectVga(), qs::RenderParams());
-  const auto [wall, share] = coveringLabel(segment(frame.depth), frame.truth, 0);
+  const auto [wall, share] = coveringLabel(qs::test::segmentRendered(frame.depth), frame.truth, 0);
   EXPECT_NE(wall, 0);
   EXPECT_GE(share, 0.8) << "the wall's two sides are not one segment";
 }
@@ -124,7 +105,7 @@ TEST(PlaneMerging, WallFragmentsBesideAHoleInTheDepthAreOneSegment) {
   // A vertical band of 60 pixels without depth (a dark or specular strip the sensor misses).
   frame.depth.colRange(290, 350).setTo(std::numeric_limits<float>::quiet_NaN());
   frame.truth.colRange(290, 350).setTo(0);
-  const auto [wall, share] = coveringLabel(segment(frame.depth), frame.truth, 0);
+  const auto [wall, share] = coveringLabel(qs::test::segmentRendered(frame.depth), frame.truth, 0);
   EXPECT_NE(wall, 0);
   EXPECT_GE(share, 0.8) << "the wall's two sides are not one segment";
 }
