@@ -13,24 +13,15 @@
 #include <map>
 #include <vector>
 
+#include "../unit/kinect_vga.h"
 #include "quadric_slam/QuadricObservationArray.h"
 #include "quadric_slam/frontend/normal_estimator.h"
-#include "quadric_slam/sim/primitive_scene_renderer.h"
 #include "quadric_slam/io/frame_source.h"
+#include "quadric_slam/sim/primitive_scene_renderer.h"
 
 namespace qs = quadric_slam;
 
 namespace {
-
-qs::CameraIntrinsics kinect() {
-  qs::CameraIntrinsics k;
-  k.fx = k.fy = 525.0;
-  k.cx = 319.5;
-  k.cy = 239.5;
-  k.width = 640;
-  k.height = 480;
-  return k;
-}
 
 // Floor 0.8 m below the camera, wall at 2.5 m, a sphere (r 0.15 m) and an upright cylinder (r 0.09
 // m).
@@ -42,10 +33,11 @@ pcl::PointCloud<pcl::PointNormal> sceneCloud() {
   scene[3].shape =
       qs::PrimitiveShape::cylinder(Eigen::Vector3d(0.3, 0.8, 1.8), Eigen::Vector3d(0, -1, 0), 0.09);
   scene[3].axis_max = 0.55;
-  const qs::PrimitiveRendering frame = qs::renderPrimitives(scene, kinect(), qs::RenderParams());
+  const qs::PrimitiveRendering frame =
+      qs::renderPrimitives(scene, qs::test::kinectVga(), qs::RenderParams());
   const qs::DepthImageView<float> view = qs::depthViewOf(frame.depth);
   return qs::NormalEstimator(qs::NormalEstimator::Params())
-      .compute(qs::backProject(view, kinect(), qs::BackProjectionParams()));
+      .compute(qs::backProject(view, qs::test::kinectVga(), qs::BackProjectionParams()));
 }
 
 class QuadricSegmentationTest : public ::testing::Test {

@@ -15,6 +15,7 @@
 #include <string>
 #include <utility>
 
+#include "../kinect_vga.h"
 #include "../test_support.h"
 #include "primitive_desk_scene.h"
 #include "quadric_slam/frontend/central_quadric.h"
@@ -233,12 +234,7 @@ TEST(GeneralDetection, ParamsValidateAndModelCovarianceScales) {
 // upside-down cone, in its two views (straight and tilted) with three noise seeds. The primitives
 // stay primitives.
 TEST(GeneralDetection, NoGeneralQuadricOnPlanesSpheresCylindersAndCones) {
-  CameraIntrinsics k;
-  k.fx = k.fy = 525.0;
-  k.cx = 319.5;
-  k.cy = 239.5;
-  k.width = 640;
-  k.height = 480;
+  const CameraIntrinsics k = test::kinectVga();
   const QuadricSegmenter segmenter{QuadricSegmenter::Params()};
   Eigen::Isometry3d tilted = Eigen::Isometry3d::Identity();
   tilted.linear() = (Eigen::AngleAxisd(0.15, Eigen::Vector3d::UnitX()) *
