@@ -43,6 +43,11 @@ void OdometryTracker::Params::validate() const {
   photometric.validate();
   if (!(photometric_information_scale > 0 && photometric_information_scale <= 1))
     check.fail("photometric_information_scale", "(0, 1]", photometric_information_scale);
+  if (!(photometric_depth_floor_translation > 0 && photometric_depth_floor_translation <= 1))
+    check.fail("photometric_depth_floor_translation", "(0, 1] m",
+               photometric_depth_floor_translation);
+  if (!(photometric_depth_floor_rotation > 0 && photometric_depth_floor_rotation <= 1))
+    check.fail("photometric_depth_floor_rotation", "(0, 1] rad", photometric_depth_floor_rotation);
 }
 
 OdometryTracker::OdometryTracker(const Params& params)
@@ -305,28 +310,37 @@ bool OdometryTracker::refinePhotometrically(const Cloud& cloud, const CameraIntr
   // ICP puts degenerate_variance along the directions it could not constrain; sigma^2 H^-1 on the
   // others is orders of magnitude smaller, so any threshold between them finds the same ones.
   constexpr double kFreeVarianceFraction = 0.5;
-  const PhotometricRefinement::Directions free =
-      freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction);
-  out = photometric_.refine(keyframe_intensity_, intensity, cloud, intrinsics,
-                            icp.T_reference_current, free);
+  const double variance_limit = kFreeVarianceFraction * params_.icp.degenerate_variance;
+  if (freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction)
+          .cols() == 0) {
+    out = PhotometricRefinement::Result();
+    out.T_reference_current = icp.T_reference_current;
+    out.message = "no free direction to refine";
+    return false;
+  }
+  // The depth's information on the directions it measured, weighed against the intensities'
+  // (refine() scales those by their residual variance; the step's covariance below scales them
+  // by photometric_information_scale, so the prior is divided by it here).
+  Matrix6 floor = Matrix6::Zero();
+  floor.diagonal().head<3>().setConstant(std::pow(params_.photometric_depth_floor_translation, 2));
+  floor.diagonal().tail<3>().setConstant(std::pow(params_.photometric_depth_floor_rotation, 2));
+  const Matrix6 depth_information = measuredInformation(icp.covariance, variance_limit, floor);
+  const double scale = params_.photometric_information_scale;
+  out =
+      photometric_.refine(keyframe_intensity_, intensity, cloud, intrinsics,
+                          icp.T_reference_current, Matrix6::Identity(), depth_information / scale);
   if (!out.refined)
     return false;
-  // The covariance: the depth's on the constrained directions, the intensities' along the free
-  // ones (both left perturbations in the keyframe frame).
-  const Matrix6 along_free = free * free.transpose();
-  const Matrix6 constrained = Matrix6::Identity() - along_free;
-  const Eigen::MatrixXd information = params_.photometric_information_scale * out.information;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(information);
+  // The covariance of the joint estimate: the scaled intensities' information plus the depth's.
+  const Matrix6 information = scale * out.information;
+  const Eigen::LDLT<Matrix6> ldlt(information);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) {
     out.refined = false;
     out.message = "the intensities' information is singular";
     out.T_reference_current = icp.T_reference_current;
     return false;
   }
-  const Eigen::MatrixXd free_covariance =
-      ldlt.solve(Eigen::MatrixXd::Identity(information.rows(), information.cols()));
-  icp.covariance =
-      constrained * icp.covariance * constrained + free * free_covariance * free.transpose();
+  icp.covariance = ldlt.solve(Matrix6::Identity());
   icp.covariance = 0.5 * (icp.covariance + icp.covariance.transpose());
   icp.T_reference_current = out.T_reference_current;
   return true;

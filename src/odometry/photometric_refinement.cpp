@@ -53,7 +53,11 @@ double huberWeight(double r, double k) {
   return a <= k ? 1.0 : k / a;
 }
 
-// The normal equations of the intensity residuals along `free` at pose T.
+// The normal equations of the intensity residuals at pose T over the free directions and the
+// brightness offset: r = I_reference(pi(T p)) - I_current(p) - offset. The offset takes up a
+// change of the sensor's exposure between the frames (a real camera's auto exposure moves a whole
+// image by several grey levels in a tenth of a second), which would otherwise pull the pose. The
+// unknowns are ordered (free directions..., offset).
 struct Normal {
   Eigen::MatrixXd H;
   Eigen::VectorXd g;
@@ -64,12 +68,14 @@ struct Normal {
 
 Normal normalEquations(const std::vector<PhotometricPoint>& points, const cv::Mat& intensity,
                        const cv::Mat& gx, const cv::Mat& gy, const LevelCamera& camera,
-                       const Eigen::Isometry3d& T, const PhotometricRefinement::Directions& free,
-                       double huber) {
+                       const Eigen::Isometry3d& T, double offset,
+                       const PhotometricRefinement::Directions& free, double huber) {
   const int k = static_cast<int>(free.cols());
   Normal n;
-  n.H = Eigen::MatrixXd::Zero(k, k);
-  n.g = Eigen::VectorXd::Zero(k);
+  n.H = Eigen::MatrixXd::Zero(k + 1, k + 1);
+  n.g = Eigen::VectorXd::Zero(k + 1);
+  Eigen::RowVectorXd J(k + 1);
+  J(k) = -1.0;
   for (const PhotometricPoint& p : points) {
     const Eigen::Vector3d P = T * p.point;
     if (!(P.z() > 1e-3))
@@ -80,8 +86,8 @@ Normal normalEquations(const std::vector<PhotometricPoint>& points, const cv::Ma
     double reference = 0, dx = 0, dy = 0;
     if (!sample(intensity, x, y, reference) || !sample(gx, x, y, dx) || !sample(gy, x, y, dy))
       continue;
-    const double r = reference - p.intensity;
-    const Eigen::RowVectorXd J = intensityJacobian(P, dx, dy, camera.fx, camera.fy) * free;
+    const double r = reference - p.intensity - offset;
+    J.head(k) = intensityJacobian(P, dx, dy, camera.fx, camera.fy) * free;
     const double w = huberWeight(r, huber);
     n.H.noalias() += w * J.transpose() * J;
     n.g.noalias() += w * r * J.transpose();
@@ -217,7 +223,7 @@ PhotometricRefinement::PhotometricRefinement(const Params& params) : params_(par
 PhotometricRefinement::Result PhotometricRefinement::refine(
     const IntensityPyramid& reference, const IntensityPyramid& current, const Cloud& current_cloud,
     const CameraIntrinsics& intrinsics, const Eigen::Isometry3d& T_reference_current,
-    const Directions& free) const {
+    const Directions& free, const Matrix6d& prior_information) const {
   Result result;
   result.T_reference_current = T_reference_current;
   const int k = static_cast<int>(free.cols());
@@ -241,7 +247,10 @@ PhotometricRefinement::Result PhotometricRefinement::refine(
 
   Eigen::Isometry3d T = T_reference_current;
   Eigen::VectorXd moved = Eigen::VectorXd::Zero(k);  // accumulated step along free
-  std::vector<PhotometricPoint> finest;
+  double offset = 0;  // brightness offset, grey levels (kept from level to level)
+  // The prior on the step from the start, in the coordinates of `free`.
+  const Eigen::MatrixXd prior = free.transpose() * prior_information * free;
+  const bool has_prior = prior.squaredNorm() > 0;
   for (int level = params_.levels - 1; level >= 0; --level) {
     const std::vector<PhotometricPoint> points =
         levelPoints(current, current_cloud, level, params_);
@@ -251,23 +260,53 @@ PhotometricRefinement::Result PhotometricRefinement::refine(
     const cv::Mat& gy = reference.gradient_y[level];
     if (level == 0) {
       const Normal start = normalEquations(points, intensity, gx, gy, camera, T_reference_current,
-                                           free, params_.huber);
+                                           0.0, free, params_.huber);
       result.rms_before = std::sqrt(start.meanSquare());
     }
-    Normal n = normalEquations(points, intensity, gx, gy, camera, T, free, params_.huber);
-    for (int iteration = 0; iteration < params_.max_iterations && n.used >= k; ++iteration) {
-      const Eigen::LDLT<Eigen::MatrixXd> ldlt(n.H);
+    Normal n = normalEquations(points, intensity, gx, gy, camera, T, offset, free, params_.huber);
+    // The intensities' normal equations are in grey levels; with a prior they are scaled to
+    // information by the level's residual variance at its start (fixed over its iterations), and
+    // the cost compared between steps is the prior's plus the scaled residuals'.
+    const double to_information = has_prior ? 1.0 / std::max(1e-6, n.meanSquare()) : 1.0;
+    const double count = std::max(1, n.used);
+    auto cost = [&](const Normal& normal, const Eigen::VectorXd& step) {
+      double c = to_information * count * normal.meanSquare();
+      if (has_prior)
+        c += step.dot(prior * step);
+      return c;
+    };
+    for (int iteration = 0; iteration < params_.max_iterations && n.used > k; ++iteration) {
+      Eigen::MatrixXd H = to_information * n.H;
+      Eigen::VectorXd g = to_information * n.g;
+      if (has_prior) {
+        H.topLeftCorner(k, k) += prior;
+        g.head(k) += prior * moved;
+      }
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
       if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0))
         break;
-      const Eigen::VectorXd delta = -ldlt.solve(n.g);
-      const Vector6d xi = free * delta;
-      const Eigen::Isometry3d candidate = pose_math::orthonormalized(pose_math::retractLeft(xi, T));
-      const Normal next =
-          normalEquations(points, intensity, gx, gy, camera, candidate, free, params_.huber);
-      if (!(next.used >= k && next.meanSquare() < n.meanSquare()))
-        break;  // no decrease: this level has converged (or the step left the image)
+      Eigen::VectorXd delta = -ldlt.solve(g);
+      // A Gauss-Newton step can overshoot where the image is far from linear over the step;
+      // halved up to kMaxHalvings times before the level counts as converged.
+      constexpr int kMaxHalvings = 3;
+      bool decreased = false;
+      Eigen::Isometry3d candidate;
+      Normal next;
+      const double current_cost = cost(n, moved);
+      for (int halving = 0; halving <= kMaxHalvings && !decreased; ++halving) {
+        if (halving > 0)
+          delta *= 0.5;
+        candidate = pose_math::orthonormalized(pose_math::retractLeft(free * delta.head(k), T));
+        next = normalEquations(points, intensity, gx, gy, camera, candidate, offset + delta(k),
+                               free, params_.huber);
+        decreased = next.used > k && cost(next, moved + delta.head(k)) < current_cost;
+      }
+      if (!decreased)
+        break;  // this level has converged (or the step left the image)
+      const Vector6d xi = free * delta.head(k);
       T = candidate;
-      moved += delta;
+      offset += delta(k);
+      moved += delta.head(k);
       n = next;
       if (xi.head<3>().norm() < params_.convergence_translation &&
           xi.tail<3>().norm() < params_.convergence_rotation)
@@ -276,8 +315,16 @@ PhotometricRefinement::Result PhotometricRefinement::refine(
     if (level == 0) {
       result.points = n.used;
       result.rms_after = std::sqrt(n.meanSquare());
+      result.brightness_offset = offset;
       const double sigma2 = std::max(1e-6, n.meanSquare());
-      result.information = n.H / sigma2;
+      // The pose's information with the offset marginalised (Schur complement).
+      const Eigen::MatrixXd H_pp = n.H.topLeftCorner(k, k);
+      const Eigen::VectorXd H_pb = n.H.topRightCorner(k, 1);
+      const double H_bb = n.H(k, k);
+      result.information =
+          (H_bb > 0 ? Eigen::MatrixXd(H_pp - H_pb * H_pb.transpose() / H_bb) : H_pp) / sigma2;
+      if (has_prior)
+        result.information += prior;
     }
   }
   const Vector6d total = free * moved;
@@ -306,6 +353,24 @@ PhotometricRefinement::Directions freeDirections(const Matrix6d& covariance,
   for (std::size_t j = 0; j < columns.size(); ++j)
     free.col(static_cast<int>(j)) = eigen.eigenvectors().col(columns[j]);
   return free;
+}
+
+Matrix6d measuredInformation(const Matrix6d& covariance, double variance_limit,
+                             const Matrix6d& floor) {
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(0.5 * (covariance + covariance.transpose()));
+  std::vector<int> columns;
+  for (int i = 0; i < 6; ++i)
+    if (eigen.eigenvalues()(i) < variance_limit)
+      columns.push_back(i);
+  if (columns.empty())
+    return Matrix6d::Zero();
+  Eigen::MatrixXd measured(6, static_cast<int>(columns.size()));
+  for (std::size_t j = 0; j < columns.size(); ++j)
+    measured.col(static_cast<int>(j)) = eigen.eigenvectors().col(columns[j]);
+  const Eigen::MatrixXd restricted = measured.transpose() * (covariance + floor) * measured;
+  const Eigen::MatrixXd inverse =
+      restricted.ldlt().solve(Eigen::MatrixXd::Identity(restricted.rows(), restricted.cols()));
+  return measured * inverse * measured.transpose();
 }
 
 }  // namespace quadric_slam

@@ -73,6 +73,10 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "increment_rotation_per_metre", params.increment_rotation_per_metre, log);
   readParam(reader, "photometric_refinement", params.photometric_refinement, log);
   readParam(reader, "photometric_information_scale", params.photometric_information_scale, log);
+  readParam(reader, "photometric_depth_floor_translation",
+            params.photometric_depth_floor_translation, log);
+  readParam(reader, "photometric_depth_floor_rotation", params.photometric_depth_floor_rotation,
+            log);
   PhotometricRefinement::Params& photometric = params.photometric;
   readParam(reader, "photometric_levels", photometric.levels, log);
   readParam(reader, "photometric_max_iterations", photometric.max_iterations, log);

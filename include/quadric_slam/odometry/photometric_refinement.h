@@ -1,10 +1,12 @@
-// Photometric refinement of a depth alignment along the directions its geometry leaves free
-// (issue 12). A wall that fills the view fixes the camera's distance to it and two rotations; the
-// motion along it is measured by the wall's texture only. The residual of a current pixel is the
-// difference between its intensity and the keyframe image's where its 3D point lands (the direct
-// method of Kerl, Sturm and Cremers, "Robust Odometry Estimation for RGB-D Cameras", ICRA 2013),
-// with Huber weights, minimised by Gauss-Newton coarse to fine over the free directions only: the
-// point-to-plane answer in the constrained directions is kept as it is.
+// Photometric refinement of a depth alignment, along the directions its geometry leaves free or
+// jointly with the depth's information as a prior (issue 12). A wall that fills the view fixes the
+// camera's distance to it and two rotations; the motion along it is measured by the wall's texture
+// only. The residual of a current pixel is the difference between its intensity and the keyframe
+// image's where its 3D point lands (the direct method of Kerl, Sturm and Cremers, "Robust Odometry
+// Estimation for RGB-D Cameras", ICRA 2013), with Huber weights, minimised by Gauss-Newton coarse
+// to fine over the free directions only: the point-to-plane answer in the constrained directions is
+// kept as it is. A brightness offset between the two images is estimated with the pose (a real
+// camera's auto exposure).
 #pragma once
 
 #include <vector>
@@ -66,6 +68,9 @@ class PhotometricRefinement {
     bool refined = false;                  // false: the start is returned unchanged (see message)
     int points = 0;                        // pixels used at the finest level
     double rms_before = 0, rms_after = 0;  // weighted intensity RMS at the finest level
+    // The brightness change between the keyframe's image and the frame's that the refinement
+    // estimated with the pose (grey levels, keyframe minus frame).
+    double brightness_offset = 0;
     // Information (J^T W J over sigma^2) along the free directions at the finest level, k x k.
     Eigen::MatrixXd information;
     std::string message;  // why not refined (empty when refined)
@@ -80,9 +85,13 @@ class PhotometricRefinement {
   // current frame in its camera frame, at the pyramids' resolution or an integer decimation of it;
   // intrinsics are those of the pyramids' level 0. Never throws on bad data: a start that cannot
   // be improved is returned with refined = false.
+  // prior_information (6 x 6, left perturbation from the start): a Gaussian prior on the move,
+  // e.g. the depth's information along the directions it measured; the intensities' residuals are
+  // then weighed as information by their variance. Zero (the default): the intensities alone.
   Result refine(const IntensityPyramid& reference, const IntensityPyramid& current,
                 const Cloud& current_cloud, const CameraIntrinsics& intrinsics,
-                const Eigen::Isometry3d& T_reference_current, const Directions& free) const;
+                const Eigen::Isometry3d& T_reference_current, const Directions& free,
+                const Matrix6d& prior_information = Matrix6d::Zero()) const;
 
  private:
   Params params_;
@@ -99,5 +108,11 @@ Eigen::Matrix<double, 1, 6> intensityJacobian(const Eigen::Vector3d& P, double g
 // cannot measure), as the columns of a 6 x k matrix (k = 0 when none).
 PhotometricRefinement::Directions freeDirections(const Matrix6d& covariance,
                                                  double degenerate_variance, double fraction);
+
+// The information of a covariance on the directions it measured (its eigenvectors with variance
+// below variance_limit), with floor (6 x 6, added to the covariance there) bounding how sure a
+// measurement can be; zero along the others.
+Matrix6d measuredInformation(const Matrix6d& covariance, double variance_limit,
+                             const Matrix6d& floor);
 
 }  // namespace quadric_slam

@@ -4,51 +4,15 @@
 
 #include <opencv2/imgcodecs.hpp>
 
-#include <fstream>
-#include <map>
-#include <sstream>
 #include <string>
 
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/odometry/point_to_plane_icp.h"
-#include "../test_data.h"
+#include "tum_fr1_xyz_pair.h"
 
 namespace quadric_slam {
 namespace {
-
-// Ground-truth pose (T_world_camera, colour optical frame) at time t, interpolated linearly in
-// position and by slerp in orientation between the two bracketing motion-capture samples.
-bool groundTruthAt(const std::string& path, double t, Eigen::Isometry3d* pose) {
-  std::ifstream in(path);
-  std::string line;
-  double t0 = 0;
-  Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
-  Eigen::Quaterniond q0 = Eigen::Quaterniond::Identity();
-  bool have_previous = false;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#')
-      continue;
-    std::istringstream fields(line);
-    double stamp, tx, ty, tz, qx, qy, qz, qw;
-    if (!(fields >> stamp >> tx >> ty >> tz >> qx >> qy >> qz >> qw))
-      continue;
-    const Eigen::Vector3d p(tx, ty, tz);
-    const Eigen::Quaterniond q(qw, qx, qy, qz);
-    if (have_previous && t0 <= t && t <= stamp) {
-      const double s = (t - t0) / (stamp - t0);
-      pose->setIdentity();
-      pose->linear() = q0.normalized().slerp(s, q.normalized()).toRotationMatrix();
-      pose->translation() = (1 - s) * p0 + s * p;
-      return true;
-    }
-    t0 = stamp;
-    p0 = p;
-    q0 = q;
-    have_previous = true;
-  }
-  return false;
-}
 
 pcl::PointCloud<pcl::PointNormal>::Ptr loadDepth(const std::string& path,
                                                  const CameraIntrinsics& k) {
@@ -74,24 +38,13 @@ pcl::PointCloud<pcl::PointNormal>::Ptr loadDepth(const std::string& path,
 // depth/mocap clock offset move the reference by several tenths of a degree. (The benchmark's
 // RGB-D SLAM trajectory gives 1.61 degrees for this pair, ICP 1.56, the interpolated truth 2.05.)
 TEST(IcpOnTumFrames, Fr1XyzMatchesMotionCapture) {
-  const std::string dir = test::shippedData("tum_frames/fr1_xyz/").string();
-  const std::string gt =
-      test::shippedData("tum_groundtruth/rgbd_dataset_freiburg1_xyz-groundtruth.txt").string();
-  const double t_a = 1305031102.160407, t_b = 1305031102.262886;
-  CameraIntrinsics k;  // Freiburg1 depth intrinsics (README of the data)
-  k.fx = 517.3;
-  k.fy = 516.5;
-  k.cx = 318.6;
-  k.cy = 255.3;
-  k.width = 640;
-  k.height = 480;
-  auto a = loadDepth(dir + "1305031102.160407.png", k);
-  auto b = loadDepth(dir + "1305031102.262886.png", k);
-  ASSERT_TRUE(a && b) << "TUM fr1_xyz depth frames not readable in " << dir;
-  Eigen::Isometry3d T_world_a, T_world_b;
-  ASSERT_TRUE(groundTruthAt(gt, t_a, &T_world_a) && groundTruthAt(gt, t_b, &T_world_b))
-      << "no ground truth around the frames' stamps in " << gt;
-  const Eigen::Isometry3d T_a_b = T_world_a.inverse() * T_world_b;
+  const CameraIntrinsics k = test::fr1Intrinsics();
+  auto a = loadDepth(test::shippedData(test::kFr1XyzDepthA).string(), k);
+  auto b = loadDepth(test::shippedData(test::kFr1XyzDepthB).string(), k);
+  ASSERT_TRUE(a && b) << "TUM fr1_xyz depth frames not readable in test/data";
+  Eigen::Isometry3d T_a_b;
+  ASSERT_TRUE(test::fr1XyzTrueMotion(test::kFr1XyzDepthStampA, test::kFr1XyzDepthStampB, &T_a_b))
+      << "no ground truth around the frames' stamps in " << test::kFr1XyzGroundTruth;
   ASSERT_GT(T_a_b.translation().norm(), 0.02);  // the frames really are apart
 
   PointToPlaneIcp icp(PointToPlaneIcp::Params{});

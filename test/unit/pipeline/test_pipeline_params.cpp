@@ -96,6 +96,10 @@ TEST(PipelineParams, OdometryYamlKeysAreAllRead) {
   EXPECT_DOUBLE_EQ(params.photometric.huber, file["photometric_huber"].as<double>());
   EXPECT_DOUBLE_EQ(params.photometric.max_translation,
                    file["photometric_max_translation"].as<double>());
+  EXPECT_DOUBLE_EQ(params.photometric_depth_floor_translation,
+                   file["photometric_depth_floor_translation"].as<double>());
+  EXPECT_DOUBLE_EQ(params.photometric_depth_floor_rotation,
+                   file["photometric_depth_floor_rotation"].as<double>());
 }
 
 TEST(PipelineParams, MappingYamlKeysAreAllRead) {
