@@ -1,5 +1,7 @@
 #include "quadric_slam/io/tum_folder_reader.h"
 
+#include "quadric_slam/io/camera_info_yaml.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -94,8 +96,13 @@ TumFolderReader::TumFolderReader(const std::string& folder, const Params& params
   params_.validate();
   while (folder_.size() > 1 && folder_.back() == '/')
     folder_.pop_back();
-  intrinsics_ = params_.intrinsics.fx != 0.0 ? params_.intrinsics
-                                             : tumIntrinsicsForSequence(baseName(folder_));
+  const std::string camera_info = folder_ + "/" + kCameraInfoFileName;
+  if (params_.intrinsics.fx != 0.0)
+    intrinsics_ = params_.intrinsics;
+  else if (fileExists(camera_info))
+    intrinsics_ = readCameraInfoYaml(camera_info);
+  else
+    intrinsics_ = tumIntrinsicsForSequence(baseName(folder_));
   if (params_.intrinsics.fx != 0.0 && params_.intrinsics.width == 0) {
     intrinsics_.width = intrinsics_.height = 0;  // from the images
   }

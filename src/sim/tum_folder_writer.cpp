@@ -1,5 +1,6 @@
 #include "quadric_slam/sim/tum_folder_writer.h"
 
+#include "quadric_slam/io/camera_info_yaml.h"
 #include "quadric_slam/sim/png_writer.h"
 
 #include <cmath>
@@ -79,6 +80,9 @@ void TumFolderWriter::finish(const std::vector<StampedPose>& frames) const {
       rgb << stamp << " rgb/" << stamp << ".png\n";
       depth << stamp << " depth/" << stamp << ".png\n";
     }
+    if (params_.camera.fx > 0)
+      writeCameraInfoYaml(directory_ + "/" + kCameraInfoFileName, params_.camera,
+                          params_.sequence_name);
   }
   std::ofstream gt = open("groundtruth.txt");
   gt << "# ground truth trajectory\n" << file;

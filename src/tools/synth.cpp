@@ -188,6 +188,7 @@ int run(int argc, char** argv) {
   folder_params.labels = o.labels;
   folder_params.png_compression = o.png_compression;
   folder_params.sequence_name = name;
+  folder_params.camera = scene.camera;
   const qs::TumFolderWriter folder(o.out, folder_params);
 
   std::unique_ptr<qs::TumBagWriter> bag;

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "quadric_slam/types/camera_intrinsics.h"
 #include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/io/trajectory_io.h"
+#include "quadric_slam/types/camera_intrinsics.h"
 
 namespace quadric_slam {
 
@@ -26,8 +26,9 @@ class TumFolderReader : public FrameSource {
     double max_rgb_difference = 0.02;       // s, RGB-depth pairing gate (associate.py default)
     bool load_rgb = true;                   // false: depth only (rgb.txt not needed)
     bool keep_frames_without_rgb = false;   // true: depth frames with no RGB partner, rgb empty
-    // fx = 0 (the default): chosen from the folder name by tumIntrinsicsForSequence. width/height
-    // 0: taken from each image; else they must match the images.
+    // fx = 0 (the default): the folder's camera_info.yaml when it has one (io/camera_info_yaml.h;
+    // the generator writes it), else chosen from the folder name by tumIntrinsicsForSequence.
+    // width/height 0: taken from each image; else they must match the images.
     CameraIntrinsics intrinsics;
     std::string frame_id = "openni_rgb_optical_frame";
 

@@ -1,6 +1,8 @@
 // Writes a sequence in the TUM RGB-D folder layout: rgb/<stamp>.png (8-bit RGB),
 // depth/<stamp>.png (16-bit, 5000 per metre, 0 = no data), rgb.txt, depth.txt, groundtruth.txt
-// (pose of the optical frame in the world), plus labels/<stamp>.png (16-bit surface ids).
+// (pose of the optical frame in the world), plus labels/<stamp>.png (16-bit surface ids) and
+// camera_info.yaml (the camera's intrinsics, io/camera_info_yaml.h: the folder reader takes them
+// from there rather than guessing from the folder's name).
 #pragma once
 
 #include <string>
@@ -18,6 +20,9 @@ class TumFolderWriter {
     bool labels = true;                       // labels/
     int png_compression = 1;                  // zlib level of the PNG files, 0 (none, fastest) .. 9
     std::string sequence_name = "synthetic";  // named in the header comments
+    // The camera the images were rendered with, written as camera_info.yaml with the images
+    // (fx = 0: not written).
+    CameraIntrinsics camera;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;
@@ -28,7 +33,7 @@ class TumFolderWriter {
 
   // Writes the frame's PNG files. Thread-safe (distinct files per frame).
   void writeFrame(const StampedPose& pose, const RenderedFrame& frame) const;
-  // Writes rgb.txt, depth.txt and groundtruth.txt for all frames.
+  // Writes rgb.txt, depth.txt, camera_info.yaml and groundtruth.txt for all frames.
   void finish(const std::vector<StampedPose>& frames) const;
 
   // TUM file-name stamp: seconds with 6 decimals.

@@ -14,6 +14,7 @@
 
 #include "../fuzz_mutations.h"
 #include "../test_data.h"
+#include "quadric_slam/io/camera_info_yaml.h"
 #include "quadric_slam/io/depth_png.h"
 #include "quadric_slam/io/tum_folder_reader.h"
 
@@ -65,8 +66,7 @@ bool sameDepth(const cv::Mat& a, const cv::Mat& b) {
 
 // A TUM folder named like the official sequence, made from the two fr1_xyz depth frames with RGB
 // partners at the sequence's RGB stamps, plus one depth image (a copy) 5 s later with no RGB
-// partner. test/data ships only the first frame's RGB image (RGB is large): it stands in for the
-// second frame's RGB image too.
+// partner.
 std::string makeFr1Folder() {
   const fs::path root =
       fs::path(::testing::TempDir()) / "tum_folder_reader_test" / "rgbd_dataset_freiburg1_xyz";
@@ -78,7 +78,7 @@ std::string makeFr1Folder() {
   fs::copy_file(src / "1305031102.262886.png", root / "depth" / "1305031102.262886.png");
   fs::copy_file(src / "1305031102.262886.png", root / "depth" / "1305031107.262886.png");
   fs::copy_file(src / "1305031102.175304.png", root / "rgb" / "1305031102.175304.png");
-  fs::copy_file(src / "1305031102.175304.png", root / "rgb" / "1305031102.275326.png");
+  fs::copy_file(src / "1305031102.275326.png", root / "rgb" / "1305031102.275326.png");
   std::ofstream(root / "depth.txt") << "# depth maps\n# file: 'rgbd_dataset_freiburg1_xyz.bag'\n"
                                        "# timestamp filename\n"
                                        "1305031102.160407 depth/1305031102.160407.png\n"
@@ -106,6 +106,35 @@ TEST(TumFolderReader, IntrinsicsBySequenceName) {
   EXPECT_DOUBLE_EQ(fallback.cx, 319.5);
   EXPECT_EQ(fallback.width, 640);
   EXPECT_EQ(fallback.height, 480);
+}
+
+// A folder that carries its camera (camera_info.yaml, as the generator writes it) is read with
+// that camera, whatever its name says: a sequence rendered with 525/525/319.5/239.5 into a folder
+// named fr1_* was read with the Freiburg 1 intrinsics (cy 16 pixels off), which bent the
+// generated benchmarks' trajectories by 1-2 % and cost centimetres of ATE.
+TEST(TumFolderReader, TheFoldersCameraInfoComesBeforeItsName) {
+  const std::string folder = makeFr1Folder();
+  EXPECT_DOUBLE_EQ(TumFolderReader(folder).intrinsics().fx, 517.3);  // by the name
+  quadric_slam::CameraIntrinsics rendered{525.0, 525.0, 319.5, 239.5, 640, 480};
+  quadric_slam::writeCameraInfoYaml(folder + "/camera_info.yaml", rendered, "synthetic");
+  TumFolderReader reader(folder);
+  EXPECT_DOUBLE_EQ(reader.intrinsics().fx, 525.0);
+  EXPECT_DOUBLE_EQ(reader.intrinsics().cy, 239.5);
+  RgbdFrame frame;
+  ASSERT_TRUE(reader.next(frame));
+  EXPECT_DOUBLE_EQ(frame.intrinsics.cy, 239.5);
+  // An explicit camera still comes first.
+  TumFolderReader::Params params;
+  params.intrinsics = quadric_slam::tumIntrinsicsForSequence("fr3");
+  EXPECT_DOUBLE_EQ(TumFolderReader(folder, params).intrinsics().fx, 535.4);
+  // A camera_info.yaml that cannot be read is an error naming it, not a silent fallback.
+  std::ofstream(folder + "/camera_info.yaml") << "image_width: 640\nimage_height: 480\n";
+  try {
+    TumFolderReader broken(folder);
+    ADD_FAILURE() << "a camera_info.yaml without camera_matrix was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("camera_info.yaml"), std::string::npos) << e.what();
+  }
 }
 
 TEST(TumFolderReader, DepthPngReadsMetresWithNanForNoData) {

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 
+#include "quadric_slam/io/camera_info_yaml.h"
 #include "quadric_slam/sim/tum_folder_writer.h"
 
 using namespace quadric_slam;
@@ -32,6 +33,7 @@ TEST(TumFolderWriter, WritesTheTumLayout) {
   std::filesystem::remove_all(dir);
   TumFolderWriter::Params params;
   params.sequence_name = "unit";
+  params.camera = CameraIntrinsics{525.0, 525.0, 319.5, 239.5, 640, 480};
   const TumFolderWriter writer(dir, params);
   RenderedFrame frame;
   frame.depth = cv::Mat(4, 6, CV_32FC1, cv::Scalar(1.5f));
@@ -54,6 +56,10 @@ TEST(TumFolderWriter, WritesTheTumLayout) {
   ASSERT_EQ(depth.type(), CV_16UC1);
   EXPECT_EQ(depth.at<std::uint16_t>(0, 0), 7500);
   EXPECT_EQ(depth.at<std::uint16_t>(1, 2), 0);
+  // The camera travels with the images: the folder reader takes it from there.
+  const CameraIntrinsics camera = readCameraInfoYaml(dir + "/camera_info.yaml");
+  EXPECT_DOUBLE_EQ(camera.fx, 525.0);
+  EXPECT_DOUBLE_EQ(camera.cy, 239.5);
   const cv::Mat labels = cv::imread(dir + "/labels/100.000000.png", cv::IMREAD_UNCHANGED);
   ASSERT_EQ(labels.type(), CV_16UC1);
   EXPECT_EQ(labels.at<std::uint16_t>(3, 5), 7);
