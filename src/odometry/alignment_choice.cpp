@@ -32,4 +32,18 @@ bool guessAlignmentReplaces(const PointToPlaneIcp::Result& from_guess,
              (1.0 + kGuessExtraCorrespondences) * from_prior.correspondences;
 }
 
+Eigen::Isometry3d priorAlongFreeDirections(const Eigen::Isometry3d& aligned,
+                                           const Eigen::Isometry3d& prior,
+                                           const Eigen::Matrix<double, 6, Eigen::Dynamic>& free) {
+  // aligned = retractLeft(xi, prior): xi = (the translation, the rotation vector) of
+  // aligned * prior^-1.
+  const Eigen::Isometry3d difference = aligned * prior.inverse();
+  const Eigen::AngleAxisd rotation(difference.linear());
+  Vector6d xi;
+  xi.head<3>() = difference.translation();
+  xi.tail<3>() = rotation.angle() * rotation.axis();
+  const Vector6d constrained = xi - free * (free.transpose() * xi);
+  return pose_math::orthonormalized(pose_math::retractLeft(constrained, prior));
+}
+
 }  // namespace quadric_slam

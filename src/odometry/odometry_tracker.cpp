@@ -212,6 +212,13 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   const bool photometric =
       have_image && icp.status == TrackingStatus::kDegenerate && !keyframe_intensity_.empty() &&
       refinePhotometrically(cloud, intrinsics, frameIntensity(), icp, out.photometric);
+  if (out.started_from_guess && icp.status == TrackingStatus::kDegenerate && !photometric) {
+    // Nothing measured the guess along the directions the depth left free (alignment_choice.h).
+    constexpr double kFreeVarianceFraction = 0.5;
+    icp.T_reference_current = priorAlongFreeDirections(
+        icp.T_reference_current, T_keyframe_odom * prediction,
+        freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction));
+  }
 
   const Eigen::Isometry3d previous = T_odom_camera_;
   bool new_keyframe = false;

@@ -61,5 +61,28 @@ TEST(AlignmentChoice, ADegenerateGuessAlignmentNeedsTheDepthBehindIt) {
       guessAlignmentReplaces(alignment(kDegenerate, 20000, 3), alignment(kDegenerate, 9085, 5)));
 }
 
+// A wall facing the camera along z leaves v_x, v_y and omega_z free; a degenerate alignment from
+// the surfaces' guess keeps the depth's distance and tilts but the prior's slide and turn.
+TEST(AlignmentChoice, TheFreeDirectionsOfAGuessAlignmentAreThePriors) {
+  Eigen::Isometry3d prior = Eigen::Isometry3d::Identity();
+  prior.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  prior.translation() = Eigen::Vector3d(0.5, -0.2, 1.0);
+  Vector6d step;
+  step << 0.25, -0.1, 0.02, 0.01, -0.015, 0.2;  // 27 cm and 11 degrees along the free directions
+  const Eigen::Isometry3d aligned = pose_math::retractLeft(step, prior);
+  Eigen::Matrix<double, 6, Eigen::Dynamic> free = Eigen::Matrix<double, 6, 3>::Zero();
+  free(0, 0) = free(1, 1) = free(5, 2) = 1;
+
+  const Eigen::Isometry3d kept = priorAlongFreeDirections(aligned, prior, free);
+  Vector6d expected_step = Vector6d::Zero();
+  expected_step(2) = 0.02;
+  expected_step(3) = 0.01;
+  expected_step(4) = -0.015;
+  EXPECT_TRUE(kept.isApprox(pose_math::retractLeft(expected_step, prior), 1e-9));
+  // Nothing free: the alignment as it is.
+  EXPECT_TRUE(priorAlongFreeDirections(aligned, prior, Eigen::Matrix<double, 6, 0>())
+                  .isApprox(aligned, 1e-9));
+}
+
 }  // namespace
 }  // namespace quadric_slam
