@@ -38,10 +38,9 @@ Eigen::Isometry3d priorAlongFreeDirections(const Eigen::Isometry3d& aligned,
   // aligned = retractLeft(xi, prior): xi = (the translation, the rotation vector) of
   // aligned * prior^-1.
   const Eigen::Isometry3d difference = aligned * prior.inverse();
-  const Eigen::AngleAxisd rotation(difference.linear());
   Vector6d xi;
   xi.head<3>() = difference.translation();
-  xi.tail<3>() = rotation.angle() * rotation.axis();
+  xi.tail<3>() = logSO3(difference.linear());
   const Vector6d constrained = xi - free * (free.transpose() * xi);
   return pose_math::orthonormalized(pose_math::retractLeft(constrained, prior));
 }

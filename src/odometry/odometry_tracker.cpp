@@ -10,6 +10,13 @@
 #include <stdexcept>
 
 namespace quadric_slam {
+namespace {
+
+// ICP puts degenerate_variance along the directions it could not constrain; sigma^2 H^-1 on the
+// others is orders of magnitude smaller, so any fraction between them finds the same free ones.
+constexpr double kFreeVarianceFraction = 0.5;
+
+}  // namespace
 
 void OdometryTracker::Params::validate() const {
   icp.validate();
@@ -214,7 +221,6 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
       refinePhotometrically(cloud, intrinsics, frameIntensity(), icp, out.photometric);
   if (out.started_from_guess && icp.status == TrackingStatus::kDegenerate && !photometric) {
     // Nothing measured the guess along the directions the depth left free (alignment_choice.h).
-    constexpr double kFreeVarianceFraction = 0.5;
     icp.T_reference_current = priorAlongFreeDirections(
         icp.T_reference_current, T_keyframe_odom * prediction,
         freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction));
@@ -314,10 +320,6 @@ bool OdometryTracker::refinePhotometrically(const Cloud& cloud, const CameraIntr
                                             const IntensityPyramid& intensity,
                                             PointToPlaneIcp::Result& icp,
                                             PhotometricRefinement::Result& out) const {
-  // ICP puts degenerate_variance along the directions it could not constrain; sigma^2 H^-1 on the
-  // others is orders of magnitude smaller, so any threshold between them finds the same ones.
-  constexpr double kFreeVarianceFraction = 0.5;
-  const double variance_limit = kFreeVarianceFraction * params_.icp.degenerate_variance;
   if (freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction)
           .cols() == 0) {
     out = PhotometricRefinement::Result();
@@ -331,7 +333,8 @@ bool OdometryTracker::refinePhotometrically(const Cloud& cloud, const CameraIntr
   Matrix6 floor = Matrix6::Zero();
   floor.diagonal().head<3>().setConstant(std::pow(params_.photometric_depth_floor_translation, 2));
   floor.diagonal().tail<3>().setConstant(std::pow(params_.photometric_depth_floor_rotation, 2));
-  const Matrix6 depth_information = measuredInformation(icp.covariance, variance_limit, floor);
+  const Matrix6 depth_information = measuredInformation(
+      icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction, floor);
   const double scale = params_.photometric_information_scale;
   out =
       photometric_.refine(keyframe_intensity_, intensity, cloud, intrinsics,

@@ -342,31 +342,37 @@ PhotometricRefinement::Result PhotometricRefinement::refine(
   return result;
 }
 
-PhotometricRefinement::Directions freeDirections(const Matrix6d& covariance,
-                                                 double degenerate_variance, double fraction) {
+namespace {
+
+// The covariance's eigenvectors whose variance is at least (free = true) or below (free = false)
+// fraction x degenerate_variance, as columns.
+PhotometricRefinement::Directions eigenvectorsOnOneSide(const Matrix6d& covariance,
+                                                        double degenerate_variance, double fraction,
+                                                        bool free) {
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(0.5 * (covariance + covariance.transpose()));
   std::vector<int> columns;
   for (int i = 0; i < 6; ++i)
-    if (eigen.eigenvalues()(i) >= fraction * degenerate_variance)
+    if ((eigen.eigenvalues()(i) >= fraction * degenerate_variance) == free)
       columns.push_back(i);
-  PhotometricRefinement::Directions free(6, static_cast<int>(columns.size()));
+  PhotometricRefinement::Directions out(6, static_cast<int>(columns.size()));
   for (std::size_t j = 0; j < columns.size(); ++j)
-    free.col(static_cast<int>(j)) = eigen.eigenvectors().col(columns[j]);
-  return free;
+    out.col(static_cast<int>(j)) = eigen.eigenvectors().col(columns[j]);
+  return out;
 }
 
-Matrix6d measuredInformation(const Matrix6d& covariance, double variance_limit,
-                             const Matrix6d& floor) {
-  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(0.5 * (covariance + covariance.transpose()));
-  std::vector<int> columns;
-  for (int i = 0; i < 6; ++i)
-    if (eigen.eigenvalues()(i) < variance_limit)
-      columns.push_back(i);
-  if (columns.empty())
+}  // namespace
+
+PhotometricRefinement::Directions freeDirections(const Matrix6d& covariance,
+                                                 double degenerate_variance, double fraction) {
+  return eigenvectorsOnOneSide(covariance, degenerate_variance, fraction, true);
+}
+
+Matrix6d measuredInformation(const Matrix6d& covariance, double degenerate_variance,
+                             double fraction, const Matrix6d& floor) {
+  const PhotometricRefinement::Directions measured =
+      eigenvectorsOnOneSide(covariance, degenerate_variance, fraction, false);
+  if (measured.cols() == 0)
     return Matrix6d::Zero();
-  Eigen::MatrixXd measured(6, static_cast<int>(columns.size()));
-  for (std::size_t j = 0; j < columns.size(); ++j)
-    measured.col(static_cast<int>(j)) = eigen.eigenvectors().col(columns[j]);
   const Eigen::MatrixXd restricted = measured.transpose() * (covariance + floor) * measured;
   const Eigen::MatrixXd inverse =
       restricted.ldlt().solve(Eigen::MatrixXd::Identity(restricted.rows(), restricted.cols()));

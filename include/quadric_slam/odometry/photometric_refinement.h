@@ -4,9 +4,10 @@
 // only. The residual of a current pixel is the difference between its intensity and the keyframe
 // image's where its 3D point lands (the direct method of Kerl, Sturm and Cremers, "Robust Odometry
 // Estimation for RGB-D Cameras", ICRA 2013), with Huber weights, minimised by Gauss-Newton coarse
-// to fine over the free directions only: the point-to-plane answer in the constrained directions is
-// kept as it is. A brightness offset between the two images is estimated with the pose (a real
-// camera's auto exposure).
+// to fine over the given directions: without a prior the point-to-plane answer in the others is
+// kept as it is; with the depth's information as a prior (what OdometryTracker does) all six
+// directions move and the depth weighs against the intensities. A brightness offset between the
+// two images is estimated with the pose (a real camera's auto exposure).
 #pragma once
 
 #include <vector>
@@ -109,10 +110,10 @@ Eigen::Matrix<double, 1, 6> intensityJacobian(const Eigen::Vector3d& P, double g
 PhotometricRefinement::Directions freeDirections(const Matrix6d& covariance,
                                                  double degenerate_variance, double fraction);
 
-// The information of a covariance on the directions it measured (its eigenvectors with variance
-// below variance_limit), with floor (6 x 6, added to the covariance there) bounding how sure a
-// measurement can be; zero along the others.
-Matrix6d measuredInformation(const Matrix6d& covariance, double variance_limit,
-                             const Matrix6d& floor);
+// The information of a covariance on the directions it measured (the complement of
+// freeDirections with the same arguments), with floor (6 x 6, added to the covariance there)
+// bounding how sure a measurement can be; zero along the free ones.
+Matrix6d measuredInformation(const Matrix6d& covariance, double degenerate_variance,
+                             double fraction, const Matrix6d& floor);
 
 }  // namespace quadric_slam

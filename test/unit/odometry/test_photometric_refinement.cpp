@@ -146,7 +146,7 @@ TEST(MeasuredInformation, IsTheFlooredInverseOnTheMeasuredDirectionsAndZeroElsew
   Matrix6d covariance = Matrix6d::Identity() * 1e-6;
   covariance(0, 0) = covariance(1, 1) = covariance(5, 5) = 1.0;  // free along the wall
   Matrix6d floor = Matrix6d::Identity() * 3e-6;
-  const Matrix6d information = measuredInformation(covariance, 0.5, floor);
+  const Matrix6d information = measuredInformation(covariance, 1.0, 0.5, floor);
   for (int i : {0, 1, 5}) {
     EXPECT_NEAR(information.row(i).norm(), 0.0, 1e-9);
     EXPECT_NEAR(information.col(i).norm(), 0.0, 1e-9);
@@ -154,7 +154,7 @@ TEST(MeasuredInformation, IsTheFlooredInverseOnTheMeasuredDirectionsAndZeroElsew
   for (int i : {2, 3, 4})
     EXPECT_NEAR(information(i, i), 1.0 / 4e-6, 1e-3);  // 1 / (1e-6 + 3e-6)
   // Nothing measured: no information.
-  EXPECT_TRUE(measuredInformation(Matrix6d::Identity(), 0.5, floor).isZero());
+  EXPECT_TRUE(measuredInformation(Matrix6d::Identity(), 1.0, 0.5, floor).isZero());
 }
 
 TEST(PhotometricRefinement, AWallWithoutTextureLeavesTheStart) {
