@@ -1,5 +1,7 @@
 #include "quadric_slam/eval/map_metrics.h"
 
+#include "quadric_slam/mapping/extent_box.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -64,6 +66,17 @@ double distanceToLine(const Eigen::Vector3d& p, const Eigen::Vector3d& line_poin
                       const Eigen::Vector3d& unit_direction) {
   const Eigen::Vector3d v = p - line_point;
   return (v - v.dot(unit_direction) * unit_direction).norm();
+}
+
+// True unless both carry an extent and their boxes, grown by margin, do not meet (both in one
+// frame; the estimate's box is moved into the truth's quadric frame).
+bool extentsOverlap(const MapFileQuadric& truth, const MapFileQuadric& estimate, double margin) {
+  if (!truth.has_extent || !estimate.has_extent)
+    return true;
+  const ExtentBox truth_box{truth.extent_min, truth.extent_max};
+  const ExtentBox estimate_box{estimate.extent_min, estimate.extent_max};
+  const Eigen::Isometry3d T_truth_estimate = truth.T_map_quadric.inverse() * estimate.T_map_quadric;
+  return truth_box.overlaps(estimate_box.transformed(T_truth_estimate), margin);
 }
 
 void requirePositive(double value, const char* name) {
@@ -137,8 +150,8 @@ std::vector<ShapeError> shapeErrors(const MapFileQuadric& truth, const MapFileQu
     // The frame's axis order is arbitrary (any relabelling is the same surface): compare the
     // semi-axes sorted by length, and the directions of the longest axes.
     const EllipsoidAxes t = ellipsoidAxes(truth), e = ellipsoidAxes(estimate);
-    return {{"center_m", (truth.T_map_quadric.translation() - estimate.T_map_quadric.translation())
-                             .norm()},
+    return {{"center_m",
+             (truth.T_map_quadric.translation() - estimate.T_map_quadric.translation()).norm()},
             {"semi_axis_1_m", std::abs(t.lengths[0] - e.lengths[0])},
             {"semi_axis_2_m", std::abs(t.lengths[1] - e.lengths[1])},
             {"semi_axis_3_m", std::abs(t.lengths[2] - e.lengths[2])},
@@ -188,6 +201,8 @@ void MapEvaluator::Params::validate() const {
   requirePositive(ellipsoid_center_gate_m, "ellipsoid_center_gate_m");
   requirePositive(ellipsoid_semi_axis_gate_m, "ellipsoid_semi_axis_gate_m");
   requirePositive(ellipsoid_angle_gate_deg, "ellipsoid_angle_gate_deg");
+  requirePositive(extent_margin_m, "extent_margin_m");
+  requirePositive(min_seen_frames, "min_seen_frames");
 }
 
 MapEvaluator::MapEvaluator(const Params& params) : params_(params) {
@@ -216,6 +231,9 @@ std::vector<double> MapEvaluator::gates(const std::string& quadric_class) const 
 MapReport MapEvaluator::evaluate(const MapFile& truth, const MapFile& estimate,
                                  const Eigen::Isometry3d& T_truth_estimate) const {
   MapReport report;
+  report.min_seen_frames = params_.min_seen_frames;
+  const bool counts_views = std::any_of(truth.quadrics.begin(), truth.quadrics.end(),
+                                        [](const MapFileQuadric& q) { return q.observations > 0; });
   std::vector<const MapFileQuadric*> truths;
   for (const MapFileQuadric& q : truth.quadrics) {
     if (!isEvaluatedClass(q.quadric_class)) {
@@ -226,6 +244,7 @@ MapReport MapEvaluator::evaluate(const MapFile& truth, const MapFile& estimate,
     TruthResult r;
     r.truth_id = q.id;
     r.quadric_class = q.quadric_class;
+    r.seen_frames = q.observations;
     report.truths.push_back(r);
     ++report.classes[q.quadric_class].truths;
   }
@@ -248,6 +267,10 @@ MapReport MapEvaluator::evaluate(const MapFile& truth, const MapFile& estimate,
     Assignment best_assignment{0, e.id, {}};
     for (std::size_t k = 0; k < truths.size(); ++k) {
       if (truths[k]->quadric_class != e.quadric_class)
+        continue;
+      if (counts_views && truths[k]->observations == 0)
+        continue;
+      if (!extentsOverlap(*truths[k], e, params_.extent_margin_m))
         continue;
       std::vector<ShapeError> errors = shapeErrors(*truths[k], e);
       bool inside = true;
@@ -278,6 +301,8 @@ MapReport MapEvaluator::evaluate(const MapFile& truth, const MapFile& estimate,
     if (list.empty()) {
       ++summary.misses;
       ++report.misses;
+      if (counts_views && r.seen_frames >= params_.min_seen_frames)
+        ++report.seen_misses;
       continue;
     }
     std::stable_sort(list.begin(), list.end(), [](const Assignment& a, const Assignment& b) {
@@ -351,8 +376,7 @@ std::map<int, double> truthRanges(const MapFile& truth,
         }
       }
     }
-    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2,
-                     distances.end());
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
     out[q.id] = distances[distances.size() / 2];
   }
   return out;
@@ -417,7 +441,7 @@ std::string formatMapReport(const MapReport& report,
   for (const TruthResult& r : report.truths) {
     out << "truth " << r.truth_id << " " << r.quadric_class;
     if (!r.matched) {
-      out << " missed\n";
+      out << " missed seen_frames " << r.seen_frames << "\n";
       continue;
     }
     out << " matched estimate " << r.estimate_id;
@@ -450,7 +474,8 @@ std::string formatMapReport(const MapReport& report,
     }
   }
   out << "map_summary matched " << report.matched << " misses " << report.misses << " duplicates "
-      << report.duplicates << " unmatched_estimates " << report.unmatched_estimates;
+      << report.duplicates << " unmatched_estimates " << report.unmatched_estimates
+      << " misses_seen_" << report.min_seen_frames << " " << report.seen_misses;
   if (report.skipped_truths + report.skipped_estimates > 0) {
     out << " skipped_truths " << report.skipped_truths << " skipped_estimates "
         << report.skipped_estimates;

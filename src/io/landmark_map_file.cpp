@@ -2,6 +2,7 @@
 
 #include "quadric_slam/geometry/quadric_class.h"
 #include "quadric_slam/geometry/shapes.h"
+#include "quadric_slam/mapping/extent_box.h"
 
 namespace quadric_slam {
 
@@ -27,6 +28,12 @@ MapFile mapFileFromLandmarks(const std::vector<QuadricLandmark>& landmarks,
       const Eigen::Vector3d radii = quadric.scale().cwiseInverse();
       entry.shape["center"] = {centre.x(), centre.y(), centre.z()};
       entry.shape["radii"] = {radii.x(), radii.y(), radii.z()};
+    }
+    const ExtentBox extent{landmark.extent_min, landmark.extent_max};
+    if (extent.known()) {
+      entry.has_extent = true;
+      entry.extent_min = extent.min;
+      entry.extent_max = extent.max;
     }
     map.quadrics.push_back(entry);
   }

@@ -58,6 +58,16 @@ MapFileQuadric readQuadric(const YAML::Node& node) {
         q.shape[key] = readVector(entry.second, "shape." + key, 0);
       }
     }
+    if (node["extent_min"] || node["extent_max"]) {
+      const std::vector<double> lo = readVector(node["extent_min"], "extent_min", 3);
+      const std::vector<double> hi = readVector(node["extent_max"], "extent_max", 3);
+      q.extent_min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
+      q.extent_max = Eigen::Vector3d(hi[0], hi[1], hi[2]);
+      if (!q.extent_min.allFinite() || !q.extent_max.allFinite() ||
+          (q.extent_max.array() < q.extent_min.array()).any())
+        throw std::runtime_error("extent_max must not be below extent_min on any axis");
+      q.has_extent = true;
+    }
   } catch (const std::exception& e) {
     throw std::runtime_error(where + e.what());
   }
@@ -138,7 +148,14 @@ std::string mapYamlString(const MapFile& map) {
       out << YAML::Key << key << YAML::Value;
       writeVector(out, values);
     }
-    out << YAML::EndMap << YAML::EndMap;
+    out << YAML::EndMap;
+    if (q.has_extent) {
+      out << YAML::Key << "extent_min" << YAML::Value;
+      writeVector(out, {q.extent_min.x(), q.extent_min.y(), q.extent_min.z()});
+      out << YAML::Key << "extent_max" << YAML::Value;
+      writeVector(out, {q.extent_max.x(), q.extent_max.y(), q.extent_max.z()});
+    }
+    out << YAML::EndMap;
   }
   out << YAML::EndSeq;
   if (!map.merged_into.empty()) {

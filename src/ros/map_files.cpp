@@ -48,6 +48,10 @@ QuadricLandmark landmarkFromMapFile(const MapFileQuadric& entry) {
   QuadricLandmark landmark;
   landmark.id = entry.id;
   landmark.observations = entry.observations;
+  if (entry.has_extent) {  // the reconstruction's points, when there are any, replace it
+    landmark.extent_min = entry.extent_min;
+    landmark.extent_max = entry.extent_max;
+  }
   if (entry.quadric_class == "ellipsoid") {
     landmark.quadric_map = QuadricModel(QuadricClass::kGeneral, entry.T_map_quadric, entry.scale,
                                         Eigen::Vector4d(1, 1, 1, -1));

@@ -297,6 +297,28 @@ MapFileQuadric Surface::toMapQuadric() const {
       q.shape["radii"] = vec(dims_);
       break;
   }
+  // The bounded piece, in the surface frame (the quadric's): see the dims convention in the header.
+  q.has_extent = true;
+  switch (kind_) {
+    case SurfaceKind::kRectangle:
+      q.extent_max = Eigen::Vector3d(0.0, dims_.y(), dims_.z());
+      break;
+    case SurfaceKind::kDisc:
+      q.extent_max = Eigen::Vector3d(0.0, dims_.y(), dims_.y());
+      break;
+    case SurfaceKind::kCone: {
+      const double rim = std::max(std::abs(dims_.y()), std::abs(dims_.z())) * dims_.x();
+      q.extent_min = Eigen::Vector3d(-rim, -rim, dims_.y());
+      q.extent_max = Eigen::Vector3d(rim, rim, dims_.z());
+      return q;
+    }
+    case SurfaceKind::kSphere:
+    case SurfaceKind::kCylinder:
+    case SurfaceKind::kEllipsoid:
+      q.extent_max = dims_;
+      break;
+  }
+  q.extent_min = -q.extent_max;
   return q;
 }
 

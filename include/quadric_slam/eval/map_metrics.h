@@ -8,6 +8,15 @@
 // primitive of its class whose every shape error is within that class's gate; per true primitive
 // the nearest assigned estimate is its match, further assigned estimates are duplicates, and a true
 // primitive without any is a miss. Estimates assigned to no truth are counted as unmatched.
+// Two more conditions tell coplanar truths apart (a floor and the disc of a column standing on it,
+// two desk tops at one height), which the shape errors alone cannot:
+//   - where both carry an extent (map schema extent_min/extent_max), the estimate's box must
+//     overlap the truth's, each grown by extent_margin_m;
+//   - where the truth file counts the frames that saw each truth (`observations`, as the
+//     generator writes), a truth seen in no frame takes no estimate.
+// A truth's `observations` is also its seen_frames: the misses among truths seen in at least
+// min_seen_frames frames are reported apart (a surface seen in a handful of frames at a grazing
+// angle is not expected in the map).
 // Classes other than plane, sphere, cylinder, cone and ellipsoid (e.g. "general": a hyperboloid)
 // are not evaluated (counted as skipped).
 #pragma once
@@ -56,6 +65,7 @@ struct TruthResult {
   double distance = 0;             // normalised shape distance of the match (see Params)
   std::vector<ShapeError> errors;  // of the match, when matched
   std::vector<int> duplicate_ids;  // further estimates assigned to this truth
+  int seen_frames = 0;             // the truth's `observations`: frames it was visible in
 };
 
 struct ClassSummary {
@@ -68,6 +78,10 @@ struct MapReport {
   std::map<std::string, ClassSummary> classes;  // keyed by class name
   int matched = 0, misses = 0, duplicates = 0, unmatched_estimates = 0;
   int skipped_truths = 0, skipped_estimates = 0;  // classes not evaluated
+  // Misses among the truths seen in at least min_seen_frames frames (0 when the truth file counts
+  // no views), and that threshold.
+  int seen_misses = 0;
+  int min_seen_frames = 0;
 };
 
 class MapEvaluator {
@@ -88,6 +102,12 @@ class MapEvaluator {
     double ellipsoid_center_gate_m = 0.2;
     double ellipsoid_semi_axis_gate_m = 0.1;  // each of the three sorted semi-axes
     double ellipsoid_angle_gate_deg = 30.0;   // the longest axes
+    // Each extent box is grown by this before the overlap test (m): the noise of an estimated
+    // box's edges and the points a segmenter loses along a surface's boundary.
+    double extent_margin_m = 0.1;
+    // A truth seen in at least this many frames is expected in the map (its miss is reported
+    // as seen_misses), >= 1.
+    int min_seen_frames = 30;
 
     // Throws std::invalid_argument naming the bad field and its allowed range (0, inf).
     void validate() const;

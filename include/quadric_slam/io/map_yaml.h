@@ -20,6 +20,14 @@ struct MapFileQuadric {
   // half_angle (1, rad); ellipsoid center (3) + radii (3, the semi-axes along quadric x, y, z).
   // Scalars are vectors of length 1.
   std::map<std::string, std::vector<double>> shape;
+  // The bounded piece of the quadric, as an axis-aligned box in the quadric frame (m): the box of
+  // the points observed on a mapped surface, or the generator's true piece (a wall's rectangle, a
+  // cylinder's length). Optional keys `extent_min`, `extent_max`, written only when has_extent:
+  // with them two coplanar surfaces (two desks at one height, a floor and a cap on it) are told
+  // apart.
+  bool has_extent = false;
+  Eigen::Vector3d extent_min = Eigen::Vector3d::Zero();
+  Eigen::Vector3d extent_max = Eigen::Vector3d::Zero();
 };
 
 struct MapFile {

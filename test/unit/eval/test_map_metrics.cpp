@@ -156,11 +156,12 @@ TEST(MapMetrics, HandMadeMapsWithKnownErrors) {
   EXPECT_EQ(report.classes.at("sphere").unmatched_estimates, 1);
 
   const std::string text = quadric_slam::formatMapReport(report);
-  EXPECT_NE(text.find("truth 2 plane missed\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("truth 2 plane missed seen_frames 0\n"), std::string::npos) << text;
   EXPECT_NE(text.find("truth 3 sphere matched estimate 13 center_m 0.050000 radius_m 0.010000"),
             std::string::npos)
       << text;
-  EXPECT_NE(text.find("map_summary matched 4 misses 1 duplicates 1 unmatched_estimates 2"),
+  EXPECT_NE(text.find("map_summary matched 4 misses 1 duplicates 1 unmatched_estimates 2 "
+                      "misses_seen_30 0"),
             std::string::npos)
       << text;
 
@@ -177,22 +178,21 @@ TEST(MapMetrics, RangesAndBandsFollowTheCameraPath) {
   MapFile truth;
   truth.quadrics.push_back(quadric(1, "plane", {{"normal", {0, 0, 1}}, {"offset", {0.0}}}));
   truth.quadrics.push_back(quadric(2, "plane", {{"normal", {1, 0, 0}}, {"offset", {3.0}}}));
+  truth.quadrics.push_back(quadric(3, "sphere", {{"center", {0.5, 0, 1.0}}, {"radius", {0.2}}}));
   truth.quadrics.push_back(
-      quadric(3, "sphere", {{"center", {0.5, 0, 1.0}}, {"radius", {0.2}}}));
-  truth.quadrics.push_back(quadric(
-      4, "cylinder", {{"point", {-2.0, 0, 0}}, {"axis", {0, 0, 1}}, {"radius", {0.5}}}));
-  truth.quadrics.push_back(quadric(
-      5, "cone", {{"apex", {0, 0, 3.0}}, {"axis", {0, 0, 1}}, {"half_angle", {M_PI / 4}}}));
+      quadric(4, "cylinder", {{"point", {-2.0, 0, 0}}, {"axis", {0, 0, 1}}, {"radius", {0.5}}}));
+  truth.quadrics.push_back(
+      quadric(5, "cone", {{"apex", {0, 0, 3.0}}, {"axis", {0, 0, 1}}, {"half_angle", {M_PI / 4}}}));
   // Cameras at 1.5 m height along x in [-0.5, 0.5]: the median camera is (0, 0, 1.5).
   std::vector<Eigen::Vector3d> cameras;
   for (int i = 0; i <= 10; ++i)
     cameras.emplace_back(-0.5 + 0.1 * i, 0.0, 1.5);
   const std::map<int, double> ranges = quadric_slam::truthRanges(truth, cameras);
   ASSERT_EQ(ranges.size(), 5u);
-  EXPECT_NEAR(ranges.at(1), 1.5, 1e-9);                              // floor below
-  EXPECT_NEAR(ranges.at(2), 3.0, 1e-9);                              // wall x = 3 (median x 0)
-  EXPECT_NEAR(ranges.at(3), std::hypot(0.5, 0.5) - 0.2, 1e-9);       // sphere from (0, 0, 1.5)
-  EXPECT_NEAR(ranges.at(4), 2.0 - 0.5, 1e-9);                        // cylinder axis at x = -2
+  EXPECT_NEAR(ranges.at(1), 1.5, 1e-9);                         // floor below
+  EXPECT_NEAR(ranges.at(2), 3.0, 1e-9);                         // wall x = 3 (median x 0)
+  EXPECT_NEAR(ranges.at(3), std::hypot(0.5, 0.5) - 0.2, 1e-9);  // sphere from (0, 0, 1.5)
+  EXPECT_NEAR(ranges.at(4), 2.0 - 0.5, 1e-9);                   // cylinder axis at x = -2
   // The cone's axis crosses the camera path: from (x, 0, 1.5) (radial |x|, axial 1.5 below the
   // apex) the distance to the 45-degree line is (1.5 - |x|) sin 45; the median |x| is 0.3.
   EXPECT_NEAR(ranges.at(5), (1.5 - 0.3) * std::sin(M_PI / 4), 1e-9);
@@ -240,4 +240,78 @@ TEST(MapMetrics, BadInputNamesTheProblem) {
     EXPECT_NE(std::string(e.what()).find("quadric 9"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("'center'"), std::string::npos) << e.what();
   }
+}
+
+namespace {
+
+// A bounded piece of a horizontal plane (normal +z) centred at `centre`, half sizes hx, hy: the
+// quadric frame's x is the normal (as the generator's rectangles), its y, z span the piece.
+MapFileQuadric horizontalPiece(int id, const Eigen::Vector3d& centre, double hx, double hy,
+                               int seen_frames) {
+  MapFileQuadric q = quadric(id, "plane", {{"normal", {0, 0, 1}}, {"offset", {centre.z()}}});
+  q.T_map_quadric.linear() << 0, 1, 0,  //
+      0, 0, 1,                          //
+      1, 0, 0;                          // columns: x -> +z, y -> +x, z -> +y
+  q.T_map_quadric.translation() = centre;
+  q.has_extent = true;
+  q.extent_min = Eigen::Vector3d(0, -hx, -hy);
+  q.extent_max = Eigen::Vector3d(0, hx, hy);
+  q.observations = seen_frames;
+  return q;
+}
+
+}  // namespace
+
+// Coplanar truths share every shape parameter: the floor and the disc of a column standing on it,
+// two desk tops at one height. The extents and the views tell them apart.
+TEST(MapMetrics, CoplanarTruthsAreToldApartByExtentsAndViews) {
+  MapFile truth;
+  truth.quadrics.push_back(horizontalPiece(1, Eigen::Vector3d(0, 0, 0), 3.5, 3.5, 1200));  // floor
+  truth.quadrics.push_back(horizontalPiece(2, Eigen::Vector3d(1, 1, 0), 0.15, 0.15, 0));   // cap
+  truth.quadrics.push_back(horizontalPiece(3, Eigen::Vector3d(-2, 0, 0.75), 0.4, 0.8, 300));
+  truth.quadrics.push_back(horizontalPiece(4, Eigen::Vector3d(1, 2.5, 0.75), 0.8, 0.4, 500));
+  truth.quadrics.push_back(horizontalPiece(5, Eigen::Vector3d(0, -3, 1.0), 0.6, 0.3, 40));
+  truth.quadrics.push_back(horizontalPiece(6, Eigen::Vector3d(2, -2, 1.2), 0.1, 0.1, 10));
+
+  // The estimate: the floor's observed part (around the cap), both desk tops as seen (a few cm
+  // short of their edges), in a frame moved by T.
+  const Eigen::Isometry3d T = someTransform();
+  MapFile estimate;
+  for (const MapFileQuadric& q :
+       {horizontalPiece(11, Eigen::Vector3d(0.5, 0.5, 0.004), 1.5, 1.5, 0),
+        horizontalPiece(13, Eigen::Vector3d(-2, 0, 0.752), 0.35, 0.7, 0),
+        horizontalPiece(14, Eigen::Vector3d(1, 2.5, 0.748), 0.7, 0.35, 0)})
+    estimate.quadrics.push_back(quadric_slam::transformQuadric(q, T.inverse()));
+
+  const MapReport report = MapEvaluator().evaluate(truth, estimate, T);
+  ASSERT_EQ(report.truths.size(), 6u);
+  EXPECT_EQ(report.truths[0].estimate_id, 11);  // the floor, not the unseen cap on it
+  EXPECT_FALSE(report.truths[1].matched);
+  EXPECT_EQ(report.truths[2].estimate_id, 13);
+  EXPECT_EQ(report.truths[3].estimate_id, 14);
+  EXPECT_EQ(report.duplicates, 0);
+  EXPECT_EQ(report.unmatched_estimates, 0);
+  // Misses: the cap (never seen), the cabinet top (40 frames), the small top (10 frames).
+  EXPECT_EQ(report.misses, 3);
+  EXPECT_EQ(report.seen_misses, 1);
+  const std::string text = quadric_slam::formatMapReport(report);
+  EXPECT_NE(text.find("truth 5 plane missed seen_frames 40\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("misses_seen_30 1"), std::string::npos) << text;
+
+  // Without extents the two desk tops are one parameter set: one desk takes both estimates.
+  MapFile no_extents = estimate;
+  for (MapFileQuadric& q : no_extents.quadrics)
+    q.has_extent = false;
+  const MapReport blind = MapEvaluator().evaluate(truth, no_extents, T);
+  EXPECT_EQ(blind.duplicates, 1);
+  EXPECT_EQ(blind.misses, 4);
+
+  // A truth file that counts no views (hand-written): every truth takes estimates, so the cap,
+  // inside the floor estimate's box, competes with the floor on the shape errors alone.
+  MapFile uncounted = truth;
+  for (MapFileQuadric& q : uncounted.quadrics)
+    q.observations = 0;
+  const MapReport any_view = MapEvaluator().evaluate(uncounted, estimate, T);
+  EXPECT_EQ(any_view.seen_misses, 0);
+  EXPECT_EQ(any_view.matched + any_view.misses, 6);
 }

@@ -27,6 +27,9 @@ TEST(LandmarkMapFile, LandmarksRoundTripThroughTheSchema) {
       qs::QuadricModel(qs::QuadricClass::kGeneral, Eigen::Isometry3d::Identity(),
                        Eigen::Vector3d(2, 3, 4), Eigen::Vector4d(1, 1, 1, -1));
 
+  landmarks[1].extent_min = Eigen::Vector3d(-0.01, -0.5, -0.3);  // the plane's observed box
+  landmarks[1].extent_max = Eigen::Vector3d(0.01, 0.6, 0.2);
+
   const qs::MapFile map =
       qs::parseMapYaml(qs::mapYamlString(qs::mapFileFromLandmarks(landmarks, "map")));
   EXPECT_EQ(map.frame_id, "map");
@@ -43,6 +46,10 @@ TEST(LandmarkMapFile, LandmarksRoundTripThroughTheSchema) {
   const qs::PlaneShape plane_back =
       qs::planeShape(qs::quadricFromShapeMap(qs::QuadricClass::kPlane, map.quadrics[1].shape));
   EXPECT_NEAR(plane_back.normal.dot(plane.normal) * plane_back.offset, 0.72, 1e-9);
+  EXPECT_FALSE(map.quadrics[0].has_extent) << "no observed box: no extent";
+  ASSERT_TRUE(map.quadrics[1].has_extent);
+  EXPECT_TRUE(map.quadrics[1].extent_min.isApprox(landmarks[1].extent_min, 1e-9));
+  EXPECT_TRUE(map.quadrics[1].extent_max.isApprox(landmarks[1].extent_max, 1e-9));
   EXPECT_EQ(map.quadrics[2].quadric_class, "ellipsoid");
   EXPECT_TRUE(map.quadrics[2].scale.isApprox(Eigen::Vector3d(2, 3, 4)));
 }

@@ -74,3 +74,47 @@ TEST(MapYaml, BadInputNamesTheProblem) {
   EXPECT_THROW(quadric_slam::parseMapYaml("quadrics: []\nmerged_into: {a: 1}\n"),
                std::runtime_error);
 }
+
+// The optional extent (box of the surface's piece in the quadric frame) survives the round trip,
+// is absent unless given, and a box with a corner missing or inverted is refused by name.
+TEST(MapYaml, ExtentIsOptionalAndChecked) {
+  MapFile map;
+  MapFileQuadric plane;
+  plane.id = 2;
+  plane.quadric_class = "plane";
+  plane.shape["normal"] = {0, 0, 1};
+  plane.shape["offset"] = {0.75};
+  plane.has_extent = true;
+  plane.extent_min = Eigen::Vector3d(-0.004, -0.8, -0.4);
+  plane.extent_max = Eigen::Vector3d(0.003, 0.8, 0.4);
+  map.quadrics.push_back(plane);
+  plane.id = 3;
+  plane.has_extent = false;
+  map.quadrics.push_back(plane);
+
+  const std::string text = quadric_slam::mapYamlString(map);
+  const MapFile back = quadric_slam::parseMapYaml(text);
+  ASSERT_EQ(back.quadrics.size(), 2u);
+  EXPECT_TRUE(back.quadrics[0].has_extent);
+  EXPECT_TRUE(back.quadrics[0].extent_min.isApprox(plane.extent_min, 1e-9));
+  EXPECT_TRUE(back.quadrics[0].extent_max.isApprox(Eigen::Vector3d(0.003, 0.8, 0.4), 1e-9));
+  EXPECT_FALSE(back.quadrics[1].has_extent);
+  EXPECT_EQ(text.find("extent_max"), text.rfind("extent_max")) << "only the first has one:\n"
+                                                               << text;
+
+  const std::string head =
+      "quadrics:\n  - {id: 5, class: plane, pose: {position: [0, 0, 0], orientation: [0, 0, 0, "
+      "1]}, scale: [1, 1, 1], ";
+  for (const std::string& bad : {std::string("extent_min: [0, 0, 0]}\n"),
+                                 std::string("extent_min: [0, 1, 0], extent_max: [0, 0, 0]}\n"),
+                                 std::string("extent_min: [0, 0], extent_max: [1, 1, 1]}\n")}) {
+    try {
+      quadric_slam::parseMapYaml(head + bad);
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const std::runtime_error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("quadric 5"), std::string::npos) << what;
+      EXPECT_NE(what.find("extent_m"), std::string::npos) << what;
+    }
+  }
+}

@@ -1,8 +1,8 @@
 // The mapping nodelet's saved maps (ros/map_files.h) and reconstruction cloud
 // (ros/reconstruction_cloud.h), without a master: a map of every class goes through the YAML and
 // PCD files and comes back with the same ids, classes, poses, scales and counts, extents from the
-// PCD points; what cannot be loaded is refused with a message naming the file; the cloud has the
-// documented fields and the landmarks' marker colours.
+// PCD points (or the YAML's); what cannot be loaded is refused with a message naming the file; the
+// cloud has the documented fields and the landmarks' marker colours.
 #include <gtest/gtest.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 
@@ -143,6 +143,16 @@ TEST_F(MapFilesTest, SaveAndLoadGiveTheSameLandmarksWithExtentsFromThePoints) {
   EXPECT_TRUE(bare.reconstruction.empty());
   for (const qs::QuadricLandmark& l : bare.landmarks)
     EXPECT_TRUE(l.extent_min.isZero() && l.extent_max.isZero()) << l.id;
+
+  // Landmarks that know their extent write it into the YAML: without the PCD they keep it.
+  std::vector<qs::QuadricLandmark> bounded = landmarks;
+  bounded[0].extent_min = Eigen::Vector3d(-0.01, -0.6, -0.4);
+  bounded[0].extent_max = Eigen::Vector3d(0.01, 0.6, 0.4);
+  qs::saveMapFiles(path, bounded, "map", qs::reconstructionCloudMsg({}, header));
+  const qs::LoadedMap yaml_only = qs::loadMapFiles(path);
+  EXPECT_TRUE(yaml_only.landmarks[0].extent_min.isApprox(bounded[0].extent_min, 1e-9));
+  EXPECT_TRUE(yaml_only.landmarks[0].extent_max.isApprox(bounded[0].extent_max, 1e-9));
+  EXPECT_TRUE(yaml_only.landmarks[1].extent_max.isZero()) << "unknown stays unknown";
 
   // An empty reconstruction writes no PCD (and removes a stale one).
   qs::saveMapFiles(path, landmarks, "map", qs::reconstructionCloudMsg(points, header));

@@ -69,8 +69,8 @@ TEST(Surfaces, ExpandPrimitivesWithIdsInSceneOrder) {
   EXPECT_EQ(s[12].toMapQuadric().quadric_class, "ellipsoid");
 }
 
-// Points found by ray casting every surface lie on the quadric written to quadrics_gt.yaml, and
-// the human-readable shape agrees with pose and scale.
+// Points found by ray casting every surface lie on the quadric written to quadrics_gt.yaml, within
+// its extent, and the human-readable shape agrees with pose and scale.
 TEST(Surfaces, HitPointsLieOnTheMapQuadric) {
   const std::vector<Surface> surfaces = buildSurfaces(oneOfEach());
   SimRandom random(17);
@@ -92,6 +92,12 @@ TEST(Surfaces, HitPointsLieOnTheMapQuadric) {
       ++hits;
       const Eigen::Vector3d p = origin + t * (target - origin);
       EXPECT_NEAR(quadricValue(q, p), 0.0, 1e-9) << surface.name();
+      // ... inside the piece's extent (quadric frame), which the evaluator compares boxes with.
+      ASSERT_TRUE(q.has_extent) << surface.name();
+      const Eigen::Vector3d p_quadric = q.T_map_quadric.inverse() * p;
+      EXPECT_TRUE((p_quadric.array() >= q.extent_min.array() - 1e-9).all() &&
+                  (p_quadric.array() <= q.extent_max.array() + 1e-9).all())
+          << surface.name() << " " << p_quadric.transpose();
       EXPECT_NEAR(normal.norm(), 1.0, 1e-9);
       // The normal is the quadric's gradient direction at p (a plane's x^2 has a double root:
       // its normal is the quadric x axis instead).
