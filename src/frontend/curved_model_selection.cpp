@@ -4,6 +4,7 @@
 
 #include "quadric_slam/frontend/curved_shape_starts.h"
 #include "quadric_slam/frontend/curved_verification.h"
+#include "quadric_slam/frontend/silhouette_taper.h"
 
 namespace quadric_slam {
 
@@ -33,6 +34,23 @@ constexpr double kTiltedConeNormalGain = 0.9;
 // (16 there, 4 here), so that the test's power does not change with the grid's decimation.
 double correlatedGridPoints(const QuadricSegmenter::Params& p) {
   return std::max(1.0, p.planes.correlated_points / 4.0);
+}
+
+// Smallest taper of a silhouette taken as a cone's (k = tan(half angle), 5 deg): below it a
+// segment's outline, cut by occluders and the segmenter's borders, says nothing.
+constexpr double kMinConeTaper = 0.09;
+
+// Whether the cone's predicted taper along the cylinder's axis is the measured one: of the same
+// sign, 0.4 to 2 times as large. The segmenter drops a curved surface's grazing edges, so the
+// measured width is a fraction of the true one; on the generated room's cone 2.6 m away the
+// measured taper was 0.43-1.2 times the predicted.
+bool coneMatchesTaper(const PrimitiveShape& cone, const PrimitiveShape& cylinder,
+                      const SilhouetteTaper& taper) {
+  if (!taper.significant(kMinConeTaper))
+    return false;
+  const double predicted = predictedTaper(cone, cylinder.direction);
+  return predicted * taper.slope > 0.0 && std::abs(taper.slope) > 0.4 * std::abs(predicted) &&
+         std::abs(taper.slope) < 2.0 * std::abs(predicted);
 }
 
 bool coneSignificantlyBetter(double cone_rms, double cylinder_rms, std::size_t n,
@@ -121,7 +139,10 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
     const auto as_cylinder = alternatives.screen(cylinderFromCone(fit.shape, points));
     const double cone_rms = alternatives.sampleRms(fit);
     if (as_cylinder && as_cylinder->rms < ratio * cone_rms &&
-        !coneSignificantlyBetter(cone_rms, as_cylinder->rms, points.size(), p))
+        !coneSignificantlyBetter(cone_rms, as_cylinder->rms, points.size(), p) &&
+        !coneMatchesTaper(
+            fit.shape, as_cylinder->shape,
+            measureSilhouetteTaper(as_cylinder->shape.point, as_cylinder->shape.direction, points)))
       if (const auto confirmed = alternatives.confirm(*as_cylinder))
         fit = *confirmed;
   }
@@ -129,6 +150,8 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
   // better (by the RMS ratio, or significantly over all the points).
   if (fit.shape.quadric_class == QuadricClass::kCylinder && p.detect_cones) {
     const double cylinder_rms = alternatives.sampleRms(fit);
+    const SilhouetteTaper taper =
+        measureSilhouetteTaper(fit.shape.point, fit.shape.direction, points);
     std::optional<ShapeRefiner::Result> best_cone;
     // The cylinder's axis tilted both ways by kConeStartTilt: a cylinder on one side of a cone
     // lies along a generator (coneFromTiltedCylinder).
@@ -138,23 +161,32 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
         coneFromTiltedCylinder(fit.shape, points, kConeStartTilt, -1.0)};
     for (int k = 0; k < 4; ++k) {
       const auto as_cone = alternatives.screen(starts[k]);
-      if (!as_cone || !(ratio * as_cone->rms < cylinder_rms ||
-                        coneSignificantlyBetter(as_cone->rms, cylinder_rms, points.size(), p)))
+      if (!as_cone)
+        continue;
+      // Far away the depth cannot tell them apart, the outline can: a cone that fits no worse
+      // than the cylinder and whose opening the silhouette shows.
+      const bool outlined =
+          as_cone->rms <= cylinder_rms && coneMatchesTaper(as_cone->shape, fit.shape, taper);
+      if (!(ratio * as_cone->rms < cylinder_rms ||
+            coneSignificantlyBetter(as_cone->rms, cylinder_rms, points.size(), p) || outlined))
         continue;
       // A cone from a tilted axis must also follow the measured normals clearly better: tilted
       // against a cylinder by its half angle, a cone hugs the visible side about as closely as the
       // cylinder does (over many points a little closer), but its normals turn across the visible
       // arc where the measured ones do not.
       const bool tilted = k >= 2;
-      if (tilted && alternatives.normalDisagreement(as_cone->shape) >
-                        kTiltedConeNormalGain * alternatives.normalDisagreement(fit.shape))
+      if (tilted && !outlined &&
+          alternatives.normalDisagreement(as_cone->shape) >
+              kTiltedConeNormalGain * alternatives.normalDisagreement(fit.shape))
         continue;
       if (!best_cone || as_cone->rms < best_cone->rms)
         best_cone = as_cone;
     }
-    // Whatever its start, no cone whose normals agree worse than the cylinder's (see above).
-    if (best_cone && alternatives.normalDisagreement(best_cone->shape) >
-                         alternatives.normalDisagreement(fit.shape))
+    // Whatever its start, no cone whose normals agree worse than the cylinder's (see above),
+    // unless the outline shows its opening.
+    if (best_cone && !coneMatchesTaper(best_cone->shape, fit.shape, taper) &&
+        alternatives.normalDisagreement(best_cone->shape) >
+            alternatives.normalDisagreement(fit.shape))
       best_cone.reset();
     if (best_cone)
       if (const auto confirmed = alternatives.confirm(*best_cone))

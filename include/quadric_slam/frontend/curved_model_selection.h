@@ -3,7 +3,10 @@
 // keep a simpler class that fits almost as well (a thin cone is a cylinder; a wide cone or a
 // cylinder on a sphere cap is a sphere), or a cone that fits clearly better than a cylinder and
 // whose normals agree with the measured ones at least as well (clearly better for a cone started
-// from the cylinder's axis tilted, which may lean against a cylinder by its half angle).
+// from the cylinder's axis tilted, which may lean against a cylinder by its half angle). Far from
+// the camera, where depth cannot tell a cone's side from a cylinder, a cone that fits no worse and
+// whose opening the segment's outline shows (frontend/silhouette_taper.h) is taken, and such a cone
+// is not turned into a cylinder.
 //
 // The alternatives are screened on an even sub-sample of the support (kScreeningPoints): most of
 // them are the wrong model (a sphere on a cylinder patch), and Levenberg-Marquardt on a wrong model
