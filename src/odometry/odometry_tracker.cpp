@@ -216,9 +216,31 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   Result out;
   PointToPlaneIcp::Result icp = alignFromBestStart(
       cloud, T_keyframe_odom * prediction, T_keyframe_odom * T_odom_camera_, observations, out);
-  const bool photometric =
-      have_image && icp.status == TrackingStatus::kDegenerate && !keyframe_intensity_.empty() &&
-      refinePhotometrically(cloud, intrinsics, frameIntensity(), icp, out.photometric);
+  bool photometric = false;
+  if (have_image && icp.status == TrackingStatus::kDegenerate && !keyframe_intensity_.empty()) {
+    // Along the directions the depth left free, an alignment from the surfaces' guess is where
+    // the guess put it, which may be right (a large step) or a wrong match (a parallel surface
+    // taken for another): the intensities are refined from there and from the prior's pose along
+    // those directions, and the better match of the two is kept.
+    PointToPlaneIcp::Result from_prior = icp;
+    photometric = refinePhotometrically(cloud, intrinsics, frameIntensity(), icp, out.photometric);
+    if (out.started_from_guess)
+      from_prior.T_reference_current = priorAlongFreeDirections(
+          from_prior.T_reference_current, T_keyframe_odom * prediction,
+          freeDirections(from_prior.covariance, params_.icp.degenerate_variance,
+                         kFreeVarianceFraction));
+    if (out.started_from_guess &&
+        startsElsewhere(from_prior.T_reference_current, icp.T_reference_current)) {
+      PhotometricRefinement::Result refined_from_prior;
+      if (refinePhotometrically(cloud, intrinsics, frameIntensity(), from_prior,
+                                refined_from_prior) &&
+          (!photometric || refined_from_prior.rms_after < out.photometric.rms_after)) {
+        icp = std::move(from_prior);
+        out.photometric = std::move(refined_from_prior);
+        photometric = true;
+      }
+    }
+  }
   if (out.started_from_guess && icp.status == TrackingStatus::kDegenerate && !photometric) {
     // Nothing measured the guess along the directions the depth left free (alignment_choice.h).
     icp.T_reference_current = priorAlongFreeDirections(
