@@ -7,6 +7,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "quadric_slam/geometry/shapes.h"
 #include "quadric_slam/odometry/odometry_tracker.h"
 #include "quadric_slam/odometry/photometric_refinement.h"
 #include "quadric_slam/odometry/pose_math.h"
@@ -283,6 +284,75 @@ TEST(PhotometricRefinement, ParamsOutsideTheirRangesAreRefused) {
   params = PhotometricRefinement::Params();
   params.min_points = params.max_points + 1;
   EXPECT_THROW(PhotometricRefinement{params}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace quadric_slam
+
+namespace quadric_slam {
+namespace {
+
+// Plane observations (the segmenter's) of the wall and of two surfaces across it, as a camera at
+// T_reference_camera sees them; shift_x moves the plane x = 1 of the second to x = 1 + shift_x, as
+// when the guess matches a surface to a different, parallel one.
+std::vector<QuadricMeasurement> planesSeenFrom(const Eigen::Isometry3d& T_reference_camera,
+                                               double shift_x) {
+  const PlaneShape planes[] = {{Eigen::Vector3d::UnitZ(), synthetic::kWallZ},
+                               {Eigen::Vector3d::UnitX(), 1.0 + shift_x},
+                               {Eigen::Vector3d::UnitY(), 1.0}};
+  std::vector<QuadricMeasurement> out;
+  for (const PlaneShape& plane : planes) {
+    const QuadricModel reference = quadricFromShape(plane);
+    QuadricMeasurement m;
+    m.quadric_camera =
+        QuadricModel(reference.quadricClass(), T_reference_camera.inverse() * reference.pose(),
+                     reference.scale());
+    m.num_points = 5000;
+    out.push_back(m);
+  }
+  return out;
+}
+
+// One step from the reference view to `truth` with the surfaces' guess made from observations
+// whose plane x = 1 is shifted by guess_shift_x in the current frame; the tracker's result and
+// its error against the truth (m).
+OdometryTracker::Result stepWithGuess(const Eigen::Isometry3d& truth, double guess_shift_x,
+                                      double* error) {
+  OdometryTracker::Params params;
+  params.photometric_refinement = true;
+  OdometryTracker tracker(params);
+  const View first = render(Eigen::Isometry3d::Identity());
+  const std::vector<QuadricMeasurement> seen_first =
+      planesSeenFrom(Eigen::Isometry3d::Identity(), 0.0);
+  tracker.track(first.cloud, vgaIntrinsics(), 0.0, &seen_first, &first.image);
+  const View second = render(truth);
+  const std::vector<QuadricMeasurement> seen_second = planesSeenFrom(truth, guess_shift_x);
+  const OdometryTracker::Result result =
+      tracker.track(second.cloud, vgaIntrinsics(), 1.0 / 30, &seen_second, &second.image);
+  *error = (truth.inverse() * tracker.pose()).translation().norm();
+  return result;
+}
+
+// A step towards the textured wall too long for ICP from the prior, taken by the surfaces' guess.
+// The depth fixes the distance and leaves the slide along the wall to the intensities, which are
+// refined from the guess's pose and from the prior's; the better match is kept. A wrong match
+// (the guess 30 cm off along the wall) is left for the prior's side; a right guess of a 25 cm
+// slide, which the prior (no motion) is far from, is kept.
+TEST(OdometryTrackerPhotometric, TheIntensitiesChooseBetweenTheGuessAndThePriorAlongTheWall) {
+  Eigen::Isometry3d towards = Eigen::Isometry3d::Identity();
+  towards.translation() = Eigen::Vector3d(0.01, 0.005, 0.4);
+  double error = 0.0;
+  const OdometryTracker::Result wrong_guess = stepWithGuess(towards, 0.3, &error);
+  ASSERT_TRUE(wrong_guess.started_from_guess) << wrong_guess.guess.message;
+  EXPECT_EQ(wrong_guess.status, TrackingStatus::kDegenerate);
+  EXPECT_TRUE(wrong_guess.photometric.refined) << wrong_guess.photometric.message;
+  EXPECT_LT(error, 0.005) << "refined where the wrong guess put it: 30 cm along the wall";
+
+  Eigen::Isometry3d slide = towards;
+  slide.translation().x() = 0.25;
+  const OdometryTracker::Result right_guess = stepWithGuess(slide, 0.0, &error);
+  ASSERT_TRUE(right_guess.started_from_guess) << right_guess.guess.message;
+  EXPECT_LT(error, 0.005) << "the prior's side won against a right guess";
 }
 
 }  // namespace
