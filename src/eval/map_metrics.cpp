@@ -245,6 +245,7 @@ MapReport MapEvaluator::evaluate(const MapFile& truth, const MapFile& estimate,
     r.truth_id = q.id;
     r.quadric_class = q.quadric_class;
     r.seen_frames = q.observations;
+    r.large_views = q.large_views;
     report.truths.push_back(r);
     ++report.classes[q.quadric_class].truths;
   }
@@ -303,6 +304,8 @@ MapReport MapEvaluator::evaluate(const MapFile& truth, const MapFile& estimate,
       ++report.misses;
       if (counts_views && r.seen_frames >= params_.min_seen_frames)
         ++report.seen_misses;
+      if (r.large_views >= params_.min_seen_frames)
+        ++report.large_view_misses;
       continue;
     }
     std::stable_sort(list.begin(), list.end(), [](const Assignment& a, const Assignment& b) {
@@ -441,7 +444,7 @@ std::string formatMapReport(const MapReport& report,
   for (const TruthResult& r : report.truths) {
     out << "truth " << r.truth_id << " " << r.quadric_class;
     if (!r.matched) {
-      out << " missed seen_frames " << r.seen_frames << "\n";
+      out << " missed seen_frames " << r.seen_frames << " large_views " << r.large_views << "\n";
       continue;
     }
     out << " matched estimate " << r.estimate_id;
@@ -475,7 +478,8 @@ std::string formatMapReport(const MapReport& report,
   }
   out << "map_summary matched " << report.matched << " misses " << report.misses << " duplicates "
       << report.duplicates << " unmatched_estimates " << report.unmatched_estimates
-      << " misses_seen_" << report.min_seen_frames << " " << report.seen_misses;
+      << " misses_seen_" << report.min_seen_frames << " " << report.seen_misses << " misses_large_"
+      << report.min_seen_frames << " " << report.large_view_misses;
   if (report.skipped_truths + report.skipped_estimates > 0) {
     out << " skipped_truths " << report.skipped_truths << " skipped_estimates "
         << report.skipped_estimates;

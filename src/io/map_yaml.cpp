@@ -38,6 +38,7 @@ MapFileQuadric readQuadric(const YAML::Node& node) {
       throw std::runtime_error("missing key 'class'");
     q.quadric_class = node["class"].as<std::string>();
     q.observations = node["observations"] ? node["observations"].as<int>() : 0;
+    q.large_views = node["large_views"] ? node["large_views"].as<int>() : 0;
     const YAML::Node pose = node["pose"];
     if (!pose)
       throw std::runtime_error("missing key 'pose'");
@@ -135,6 +136,8 @@ std::string mapYamlString(const MapFile& map) {
     out << YAML::Key << "id" << YAML::Value << q.id;
     out << YAML::Key << "class" << YAML::Value << q.quadric_class;
     out << YAML::Key << "observations" << YAML::Value << q.observations;
+    if (q.large_views > 0)
+      out << YAML::Key << "large_views" << YAML::Value << q.large_views;
     out << YAML::Key << "pose" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "position" << YAML::Value;
     writeVector(out, {t.x(), t.y(), t.z()});

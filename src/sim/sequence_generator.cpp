@@ -40,6 +40,7 @@ SequenceGenerator::Stats SequenceGenerator::run(const std::vector<StampedPose>& 
     max_id = std::max(max_id, s.id());
   Stats stats;
   stats.observations.assign(max_id + 1, 0);
+  stats.large_views.assign(max_id + 1, 0);
   stats.pixels.assign(max_id + 1, 0);
 
   std::mutex mutex;
@@ -84,6 +85,7 @@ SequenceGenerator::Stats SequenceGenerator::run(const std::vector<StampedPose>& 
         for (int id = 1; id <= max_id; ++id) {
           stats.pixels[id] += counts[id];
           stats.observations[id] += counts[id] > 0 ? 1 : 0;
+          stats.large_views[id] += counts[id] >= kLargeViewPixels ? 1 : 0;
         }
         done[index] = std::move(frame);
         changed.notify_all();

@@ -226,6 +226,7 @@ int run(int argc, char** argv) {
   for (const qs::Surface& s : renderer.surfaces()) {
     qs::MapFileQuadric q = s.toMapQuadric();
     q.observations = stats.observations[s.id()];
+    q.large_views = stats.large_views[s.id()];
     truth.quadrics.push_back(q);
   }
   qs::writeMapYaml(truth, o.out + "/quadrics_gt.yaml");

@@ -16,7 +16,8 @@
 //     generator writes), a truth seen in no frame takes no estimate.
 // A truth's `observations` is also its seen_frames: the misses among truths seen in at least
 // min_seen_frames frames are reported apart (a surface seen in a handful of frames at a grazing
-// angle is not expected in the map).
+// angle is not expected in the map), and so are those among truths with that many large views
+// (the truth's `large_views`: frames in which it covered 2000 pixels or more).
 // Classes other than plane, sphere, cylinder, cone and ellipsoid (e.g. "general": a hyperboloid)
 // are not evaluated (counted as skipped).
 #pragma once
@@ -66,6 +67,7 @@ struct TruthResult {
   std::vector<ShapeError> errors;  // of the match, when matched
   std::vector<int> duplicate_ids;  // further estimates assigned to this truth
   int seen_frames = 0;             // the truth's `observations`: frames it was visible in
+  int large_views = 0;             // the truth's `large_views`: frames it covered >= 2000 px in
 };
 
 struct ClassSummary {
@@ -82,6 +84,8 @@ struct MapReport {
   // no views), and that threshold.
   int seen_misses = 0;
   int min_seen_frames = 0;
+  // Misses among the truths with at least min_seen_frames large views (2000 pixels or more).
+  int large_view_misses = 0;
 };
 
 class MapEvaluator {

@@ -13,6 +13,9 @@ struct MapFileQuadric {
   int id = 0;
   std::string quadric_class;  // plane | sphere | cylinder | cone | ellipsoid | general
   int observations = 0;
+  // Truth files only (optional key `large_views`, written when > 0): frames in which the surface
+  // covered at least 2000 pixels (sim/sequence_generator.h kLargeViewPixels).
+  int large_views = 0;
   Eigen::Isometry3d T_map_quadric = Eigen::Isometry3d::Identity();
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();  // diagonal of S (1/m)
   // Human-readable shape, keyed as in the schema: plane normal (3) + offset (1); sphere center (3)

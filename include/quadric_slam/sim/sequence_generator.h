@@ -19,6 +19,11 @@ inline std::uint64_t frameNoiseSeed(std::uint64_t seed, std::size_t index) {
   return seed * 1000003ULL + index;
 }
 
+// Pixels a surface covers in a frame for the frame to count as a large view of it: what
+// eval_segmentation needs to score a surface in a frame (a strip seen at a grazing angle, or a
+// corner of a surface at the image's edge, is seen but not a surface a segmenter can find).
+constexpr int kLargeViewPixels = 2000;
+
 class SequenceGenerator {
  public:
   struct Params {
@@ -32,6 +37,7 @@ class SequenceGenerator {
 
   struct Stats {
     std::vector<int> observations;   // index = surface id (0 unused): frames with >= 1 pixel
+    std::vector<int> large_views;    // index = surface id: frames with >= kLargeViewPixels pixels
     std::vector<long> pixels;        // index = surface id: labelled pixels over all frames
     double wall_seconds = 0.0;       // whole run
     double render_seconds = 0.0;     // summed over workers

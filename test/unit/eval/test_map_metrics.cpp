@@ -156,12 +156,13 @@ TEST(MapMetrics, HandMadeMapsWithKnownErrors) {
   EXPECT_EQ(report.classes.at("sphere").unmatched_estimates, 1);
 
   const std::string text = quadric_slam::formatMapReport(report);
-  EXPECT_NE(text.find("truth 2 plane missed seen_frames 0\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("truth 2 plane missed seen_frames 0 large_views 0\n"), std::string::npos)
+      << text;
   EXPECT_NE(text.find("truth 3 sphere matched estimate 13 center_m 0.050000 radius_m 0.010000"),
             std::string::npos)
       << text;
   EXPECT_NE(text.find("map_summary matched 4 misses 1 duplicates 1 unmatched_estimates 2 "
-                      "misses_seen_30 0"),
+                      "misses_seen_30 0 misses_large_30 0"),
             std::string::npos)
       << text;
 
@@ -272,6 +273,10 @@ TEST(MapMetrics, CoplanarTruthsAreToldApartByExtentsAndViews) {
   truth.quadrics.push_back(horizontalPiece(4, Eigen::Vector3d(1, 2.5, 0.75), 0.8, 0.4, 500));
   truth.quadrics.push_back(horizontalPiece(5, Eigen::Vector3d(0, -3, 1.0), 0.6, 0.3, 40));
   truth.quadrics.push_back(horizontalPiece(6, Eigen::Vector3d(2, -2, 1.2), 0.1, 0.1, 10));
+  // Frames with 2000 pixels or more of it: the cabinet top 32, a strip seen in 50 frames 5.
+  truth.quadrics[4].large_views = 32;
+  truth.quadrics.push_back(horizontalPiece(7, Eigen::Vector3d(-2, -3, 1.6), 0.5, 0.05, 50));
+  truth.quadrics.back().large_views = 5;
 
   // The estimate: the floor's observed part (around the cap), both desk tops as seen (a few cm
   // short of their edges), in a frame moved by T.
@@ -284,19 +289,22 @@ TEST(MapMetrics, CoplanarTruthsAreToldApartByExtentsAndViews) {
     estimate.quadrics.push_back(quadric_slam::transformQuadric(q, T.inverse()));
 
   const MapReport report = MapEvaluator().evaluate(truth, estimate, T);
-  ASSERT_EQ(report.truths.size(), 6u);
+  ASSERT_EQ(report.truths.size(), 7u);
   EXPECT_EQ(report.truths[0].estimate_id, 11);  // the floor, not the unseen cap on it
   EXPECT_FALSE(report.truths[1].matched);
   EXPECT_EQ(report.truths[2].estimate_id, 13);
   EXPECT_EQ(report.truths[3].estimate_id, 14);
   EXPECT_EQ(report.duplicates, 0);
   EXPECT_EQ(report.unmatched_estimates, 0);
-  // Misses: the cap (never seen), the cabinet top (40 frames), the small top (10 frames).
-  EXPECT_EQ(report.misses, 3);
-  EXPECT_EQ(report.seen_misses, 1);
+  // Misses: the cap (never seen), the cabinet top (40 frames, 32 large), the small top (10
+  // frames), the strip (50 frames, 5 large).
+  EXPECT_EQ(report.misses, 4);
+  EXPECT_EQ(report.seen_misses, 2);
+  EXPECT_EQ(report.large_view_misses, 1);
   const std::string text = quadric_slam::formatMapReport(report);
-  EXPECT_NE(text.find("truth 5 plane missed seen_frames 40\n"), std::string::npos) << text;
-  EXPECT_NE(text.find("misses_seen_30 1"), std::string::npos) << text;
+  EXPECT_NE(text.find("truth 5 plane missed seen_frames 40 large_views 32\n"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("misses_seen_30 2 misses_large_30 1"), std::string::npos) << text;
 
   // Without extents the two desk tops are one parameter set: one desk takes both estimates.
   MapFile no_extents = estimate;
@@ -304,7 +312,7 @@ TEST(MapMetrics, CoplanarTruthsAreToldApartByExtentsAndViews) {
     q.has_extent = false;
   const MapReport blind = MapEvaluator().evaluate(truth, no_extents, T);
   EXPECT_EQ(blind.duplicates, 1);
-  EXPECT_EQ(blind.misses, 4);
+  EXPECT_EQ(blind.misses, 5);
 
   // A truth file that counts no views (hand-written): every truth takes estimates, so the cap,
   // inside the floor estimate's box, competes with the floor on the shape errors alone.
@@ -313,5 +321,5 @@ TEST(MapMetrics, CoplanarTruthsAreToldApartByExtentsAndViews) {
     q.observations = 0;
   const MapReport any_view = MapEvaluator().evaluate(uncounted, estimate, T);
   EXPECT_EQ(any_view.seen_misses, 0);
-  EXPECT_EQ(any_view.matched + any_view.misses, 6);
+  EXPECT_EQ(any_view.matched + any_view.misses, 7);
 }

@@ -16,6 +16,7 @@ TEST(MapYaml, RoundTripKeepsEveryField) {
   sphere.id = 3;
   sphere.quadric_class = "sphere";
   sphere.observations = 57;
+  sphere.large_views = 41;
   sphere.T_map_quadric.translation() = Eigen::Vector3d(0.2, 0.9, 0.55);
   sphere.T_map_quadric.linear() =
       Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
@@ -32,6 +33,7 @@ TEST(MapYaml, RoundTripKeepsEveryField) {
   EXPECT_EQ(q.id, 3);
   EXPECT_EQ(q.quadric_class, "sphere");
   EXPECT_EQ(q.observations, 57);
+  EXPECT_EQ(q.large_views, 41);
   EXPECT_TRUE(q.T_map_quadric.isApprox(sphere.T_map_quadric, 1e-8));
   EXPECT_TRUE(q.scale.isApprox(sphere.scale, 1e-8));
   EXPECT_EQ(q.shape.at("center").size(), 3u);

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <opencv2/core.hpp>
 #include <stdexcept>
 
 #include "quadric_slam/sim/sequence_generator.h"
@@ -14,7 +15,7 @@ Renderer ballRenderer() {
   PrimitiveSpec ball;
   ball.name = "ball";
   ball.type = PrimitiveType::kSphere;
-  ball.radius = 0.2;
+  ball.radius = 0.45;  // about 2800 of the 4800 pixels: a large view (kLargeViewPixels)
   ball.T_world_primitive.translation() = Eigen::Vector3d(0, 0, 1.5);
   scene.primitives.push_back(ball);
   PrimitiveSpec other = ball;
@@ -40,11 +41,14 @@ TEST(SequenceGenerator, DeliversFramesInOrderAndCountsObservations) {
   const SequenceGenerator generator(renderer, params);
   std::vector<std::size_t> order;
   std::atomic<int> per_frame_calls{0};
+  std::vector<int> large_views(3, 0);  // counted here from the labels, as the stats should
   const SequenceGenerator::Stats stats = generator.run(
       poses, [&](std::size_t, const StampedPose&, const RenderedFrame&) { ++per_frame_calls; },
       [&](std::size_t index, const StampedPose& pose, const RenderedFrame& frame) {
         EXPECT_EQ(pose.stamp, poses[index].stamp);
         EXPECT_EQ(frame.labels.cols, 80);
+        for (int id = 1; id <= 2; ++id)
+          large_views[id] += cv::countNonZero(frame.labels == id) >= kLargeViewPixels ? 1 : 0;
         order.push_back(index);
       });
   ASSERT_EQ(order.size(), poses.size());
@@ -55,6 +59,10 @@ TEST(SequenceGenerator, DeliversFramesInOrderAndCountsObservations) {
   EXPECT_EQ(stats.observations[1], 10);
   EXPECT_EQ(stats.observations[2], 10);
   EXPECT_GT(stats.pixels[1], 10 * 100);
+  ASSERT_EQ(stats.large_views.size(), 3u);
+  EXPECT_EQ(stats.large_views[1], large_views[1]);
+  EXPECT_EQ(stats.large_views[2], large_views[2]);
+  EXPECT_EQ(large_views[1], 10);
 }
 
 TEST(SequenceGenerator, RethrowsCallbackErrors) {
