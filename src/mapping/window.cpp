@@ -285,7 +285,7 @@ WindowStatistics SlidingWindow::optimize(LandmarkRegistry* map) {
   last_.residual_blocks = problem.NumResidualBlocks();
   last_.residuals = problem.NumResiduals();
 
-  const ceres::Solver::Options options = landmarkSolverOptions(params_.max_iterations);
+  const ceres::Solver::Options options = windowSolverOptions(params_.max_iterations, n);
   ceres::Solver::Summary summary;
   ceres::Solve(options, &problem, &summary);
   last_.iterations = static_cast<int>(summary.iterations.size());

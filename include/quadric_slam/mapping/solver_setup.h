@@ -16,6 +16,11 @@ namespace quadric_slam {
 // the other cores), no output; the caller picks the trust-region strategy.
 ceres::Solver::Options landmarkSolverOptions(int max_iterations);
 
+// landmarkSolverOptions for a sliding window of `pose_blocks` keyframes: dense Schur while the
+// reduced system (the poses and the landmarks a marginalisation prior ties together, a few hundred
+// variables) is small enough that a dense Cholesky beats a sparse one's bookkeeping, sparse above.
+ceres::Solver::Options windowSolverOptions(int max_iterations, int pose_blocks);
+
 // One landmark's parameter block in a solved problem and the size of its minimal tangent.
 struct LandmarkBlock {
   const double* parameters = nullptr;
