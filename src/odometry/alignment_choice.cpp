@@ -32,6 +32,15 @@ bool guessAlignmentReplaces(const PointToPlaneIcp::Result& from_guess,
              (1.0 + kGuessExtraCorrespondences) * from_prior.correspondences;
 }
 
+bool betterPhotometricMatch(const PhotometricRefinement::Result& a,
+                            const PhotometricRefinement::Result& b) {
+  if (a.points < kPhotometricMinPointShare * b.points)
+    return false;
+  if (b.points < kPhotometricMinPointShare * a.points)
+    return true;
+  return a.rms_after < b.rms_after;
+}
+
 Eigen::Isometry3d priorAlongFreeDirections(const Eigen::Isometry3d& aligned,
                                            const Eigen::Isometry3d& prior,
                                            const Eigen::Matrix<double, 6, Eigen::Dynamic>& free) {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <vector>
 #include <sstream>
 #include <stdexcept>
 
@@ -218,25 +219,32 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
       cloud, T_keyframe_odom * prediction, T_keyframe_odom * T_odom_camera_, observations, out);
   bool photometric = false;
   if (have_image && icp.status == TrackingStatus::kDegenerate && !keyframe_intensity_.empty()) {
-    // Along the directions the depth left free, an alignment from the surfaces' guess is where
-    // the guess put it, which may be right (a large step) or a wrong match (a parallel surface
-    // taken for another): the intensities are refined from there and from the prior's pose along
-    // those directions, and the better match of the two is kept.
-    PointToPlaneIcp::Result from_prior = icp;
-    photometric = refinePhotometrically(cloud, intrinsics, frameIntensity(), icp, out.photometric);
-    if (out.started_from_guess)
-      from_prior.T_reference_current = priorAlongFreeDirections(
-          from_prior.T_reference_current, T_keyframe_odom * prediction,
-          freeDirections(from_prior.covariance, params_.icp.degenerate_variance,
-                         kFreeVarianceFraction));
-    if (out.started_from_guess &&
-        startsElsewhere(from_prior.T_reference_current, icp.T_reference_current)) {
-      PhotometricRefinement::Result refined_from_prior;
-      if (refinePhotometrically(cloud, intrinsics, frameIntensity(), from_prior,
-                                refined_from_prior) &&
-          (!photometric || refined_from_prior.rms_after < out.photometric.rms_after)) {
-        icp = std::move(from_prior);
-        out.photometric = std::move(refined_from_prior);
+    // Along the directions the depth left free an alignment stays where it started: the
+    // constant-velocity prior, the last pose or the surfaces' guess, any of which may be far off
+    // there (a hand-held camera at 3 Hz turns 10-25 degrees per step and changes its turn rate;
+    // a guess may match a parallel surface to the wrong one). The intensities' basin is a few
+    // degrees wide, so they are refined from the alignment and from it moved along its free
+    // directions to the prior's and to the last pose's, and the best match is kept.
+    const Eigen::Matrix<double, 6, Eigen::Dynamic> free =
+        freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction);
+    std::vector<Eigen::Isometry3d> starts = {icp.T_reference_current};
+    for (const Eigen::Isometry3d& other : {Eigen::Isometry3d(T_keyframe_odom * prediction),
+                                           Eigen::Isometry3d(T_keyframe_odom * T_odom_camera_)}) {
+      const Eigen::Isometry3d moved =
+          priorAlongFreeDirections(icp.T_reference_current, other, free);
+      if (std::all_of(starts.begin(), starts.end(),
+                      [&](const Eigen::Isometry3d& s) { return startsElsewhere(s, moved); }))
+        starts.push_back(moved);
+    }
+    const PointToPlaneIcp::Result aligned = icp;
+    for (const Eigen::Isometry3d& start : starts) {
+      PointToPlaneIcp::Result candidate = aligned;
+      candidate.T_reference_current = start;
+      PhotometricRefinement::Result refined;
+      if (refinePhotometrically(cloud, intrinsics, frameIntensity(), candidate, refined) &&
+          (!photometric || betterPhotometricMatch(refined, out.photometric))) {
+        icp = std::move(candidate);
+        out.photometric = std::move(refined);
         photometric = true;
       }
     }

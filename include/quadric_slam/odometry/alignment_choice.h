@@ -2,6 +2,7 @@
 // constant-velocity prediction, the last pose and the surfaces' motion guess as starts).
 #pragma once
 
+#include "quadric_slam/odometry/photometric_refinement.h"
 #include "quadric_slam/odometry/point_to_plane_icp.h"
 
 namespace quadric_slam {
@@ -35,5 +36,13 @@ bool guessAlignmentReplaces(const PointToPlaneIcp::Result& from_guess,
 Eigen::Isometry3d priorAlongFreeDirections(const Eigen::Isometry3d& aligned,
                                            const Eigen::Isometry3d& prior,
                                            const Eigen::Matrix<double, 6, Eigen::Dynamic>& free);
+
+// Of two photometric refinements of one frame from different starts, a matches the keyframe's
+// intensities better than b: the lower intensity RMS, unless a kept fewer than
+// kPhotometricMinPointShare of b's pixels in view (a start that pushes the frame off the keyframe's
+// image keeps only a few pixels, whose RMS says little).
+constexpr double kPhotometricMinPointShare = 0.75;
+bool betterPhotometricMatch(const PhotometricRefinement::Result& a,
+                            const PhotometricRefinement::Result& b);
 
 }  // namespace quadric_slam

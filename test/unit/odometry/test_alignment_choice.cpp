@@ -1,6 +1,7 @@
 // Which ICP alignment the tracker keeps (odometry/alignment_choice.h): the better one by inliers
 // and residual, and an alignment from the surfaces' guess over the prior's only where the depth
-// backs the guess along the directions it constrains.
+// backs the guess along the directions it constrains; of photometric refinements from several
+// starts, the better intensity match.
 #include <gtest/gtest.h>
 
 #include "quadric_slam/odometry/alignment_choice.h"
@@ -82,6 +83,22 @@ TEST(AlignmentChoice, TheFreeDirectionsOfAGuessAlignmentAreThePriors) {
   // Nothing free: the alignment as it is.
   EXPECT_TRUE(priorAlongFreeDirections(aligned, prior, Eigen::Matrix<double, 6, 0>())
                   .isApprox(aligned, 1e-9));
+}
+
+PhotometricRefinement::Result refinement(int points, double rms_after) {
+  PhotometricRefinement::Result r;
+  r.refined = true;
+  r.points = points;
+  r.rms_after = rms_after;
+  return r;
+}
+
+TEST(AlignmentChoice, TheBetterPhotometricMatchHasTheLowerRmsOverComparablePixels) {
+  EXPECT_TRUE(betterPhotometricMatch(refinement(2400, 9.0), refinement(2380, 13.1)));
+  EXPECT_FALSE(betterPhotometricMatch(refinement(2380, 13.1), refinement(2400, 9.0)));
+  // A start that leaves only a few pixels in the keyframe's view does not win by their RMS.
+  EXPECT_FALSE(betterPhotometricMatch(refinement(1000, 5.0), refinement(2400, 9.0)));
+  EXPECT_TRUE(betterPhotometricMatch(refinement(2400, 9.0), refinement(1000, 5.0)));
 }
 
 }  // namespace

@@ -357,3 +357,36 @@ TEST(OdometryTrackerPhotometric, TheIntensitiesChooseBetweenTheGuessAndThePriorA
 
 }  // namespace
 }  // namespace quadric_slam
+
+namespace quadric_slam {
+namespace {
+
+// A camera sliding along the textured wall at 4 cm a frame; after the first step two frames are
+// dropped, so the next one arrives 16 cm along the wall. The depth stays degenerate along the wall
+// and its alignments from the prior (constant velocity, scaled to the gap: right) and from the last
+// pose (12 cm short) match the wall equally well, so the last pose wins the tie; the intensities,
+// refined from there, may not move 12 cm (the refinement's 10 cm limit). They are refined from
+// the alignment moved along its free directions to the prior's pose as well, and the better match
+// is kept.
+TEST(OdometryTrackerPhotometric, AfterDroppedFramesTheIntensitiesStartFromThePriorToo) {
+  OdometryTracker::Params params;
+  params.photometric_refinement = true;
+  OdometryTracker tracker(params);
+  const double stamps[] = {0.0, 1.0 / 30, 4.0 / 30};
+  const double slide[] = {0.0, 0.04, 0.16};
+  Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
+  OdometryTracker::Result result;
+  for (int i = 0; i < 3; ++i) {
+    truth.translation() = Eigen::Vector3d(slide[i], 0.3 * slide[i], 0.0);
+    const View view = render(truth);
+    result = tracker.track(view.cloud, vgaIntrinsics(), stamps[i], nullptr, &view.image);
+  }
+  EXPECT_EQ(result.status, TrackingStatus::kDegenerate);
+  EXPECT_TRUE(result.photometric.refined) << result.photometric.message;
+  const double error = (truth.inverse() * tracker.pose()).translation().norm();
+  EXPECT_LT(error, 0.005) << "the step after the dropped frames ends " << error
+                          << " m off (12 cm: where the last pose left it)";
+}
+
+}  // namespace
+}  // namespace quadric_slam
