@@ -22,12 +22,13 @@
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
 #include "quadric_slam/frontend/segmentation_score.h"
-#include "quadric_slam/pipeline/segmenter_params.h"
 #include "quadric_slam/geometry/shapes.h"
 #include "quadric_slam/io/depth_png.h"
 #include "quadric_slam/io/frame_source.h"
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/io/trajectory_io.h"
+#include "quadric_slam/pipeline/segmenter_params.h"
+#include "quadric_slam/sim/sequence_generator.h"
 
 namespace qs = quadric_slam;
 
@@ -39,7 +40,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string dir = argv[1];
-  int stride = 1, max_frames = 1 << 30, min_pixels = 2000;
+  int stride = 1, max_frames = 1 << 30, min_pixels = qs::kLargeViewPixels;
   double max_range = 2.0;
   bool verbose = false;
   qs::QuadricSegmenter::Params params;

@@ -20,7 +20,7 @@ inline std::uint64_t frameNoiseSeed(std::uint64_t seed, std::size_t index) {
 }
 
 // Pixels a surface covers in a frame for the frame to count as a large view of it: what
-// eval_segmentation needs to score a surface in a frame (a strip seen at a grazing angle, or a
+// eval_segmentation needs by default to score a surface in a frame (a strip seen at a grazing angle, or a
 // corner of a surface at the image's edge, is seen but not a surface a segmenter can find).
 constexpr int kLargeViewPixels = 2000;
 
