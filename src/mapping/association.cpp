@@ -75,6 +75,13 @@ void QuadricAssociator::Params::validate() const {
   requireRange(extent_margin >= 0.0, "extent_margin", "[0, inf) m");
   requireRange(max_range > 0.0, "max_range", "(0, inf) m");
   requireRange(cross_class_distance >= 0.0, "cross_class_distance", "[0, inf) m");
+  requireRange(cross_class_rms_factor >= 0.0, "cross_class_rms_factor", "[0, inf)");
+}
+
+double QuadricAssociator::Params::crossClassGate(double fit_rms) const {
+  if (cross_class_distance <= 0.0)
+    return 0.0;  // the test is off
+  return std::max(cross_class_distance, cross_class_rms_factor * std::max(0.0, fit_rms));
 }
 
 QuadricAssociator::QuadricAssociator(const Params& params) : params_(params) {

@@ -13,6 +13,11 @@ namespace quadric_slam {
 
 namespace {
 
+// The fit RMS of a candidate's latest measurement (the one its quadric_map is); 0 when unknown.
+double latestFitRms(const QuadricCandidate& candidate) {
+  return candidate.history.empty() ? 0.0 : candidate.history.back().measurement.fit_rms;
+}
+
 ExtentBox landmarkExtent(const QuadricLandmark& landmark) {
   return ExtentBox{landmark.extent_min, landmark.extent_max};
 }
@@ -87,9 +92,10 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
     } else {
       // 1b. A surface fitted with another class than its landmark's (a cone's band as a
       // cylinder, a patch as a sphere ...): counted there, no factor.
-      landmark_id = otherClassLandmark(
-          measurements[m].quadric_camera.transformed(T_map_camera),
-          ExtentBox{measurements[m].extent_min, measurements[m].extent_max}, T_map_camera);
+      landmark_id =
+          otherClassLandmark(measurements[m].quadric_camera.transformed(T_map_camera),
+                             ExtentBox{measurements[m].extent_min, measurements[m].extent_max},
+                             measurements[m].fit_rms, T_map_camera);
       update.measurements[m].without_factor = landmark_id != 0;
     }
     if (landmark_id == 0) {
@@ -186,8 +192,8 @@ MapUpdate LandmarkRegistry::integrate(int frame_index, double stamp,
   for (QuadricCandidate& candidate : candidates_) {
     if (promotion_ && candidate.last_frame == frame_index &&
         candidate.observations >= params_.min_observations) {
-      const int absorbed =
-          otherClassLandmark(candidate.quadric_map, candidate.extent, T_map_camera);
+      const int absorbed = otherClassLandmark(candidate.quadric_map, candidate.extent,
+                                              latestFitRms(candidate), T_map_camera);
       if (absorbed != 0) {
         // Its observations count on the landmark of the other class, without factors.
         countCandidateOn(candidate, &landmarks_.at(absorbed));
@@ -237,7 +243,8 @@ MapUpdate LandmarkRegistry::promoteObserved(int min_observations,
   std::vector<QuadricCandidate> kept;
   for (QuadricCandidate& candidate : candidates_) {
     if (candidate.observations < min_observations ||
-        otherClassLandmark(candidate.quadric_map, candidate.extent, T_map_camera) != 0 ||
+        otherClassLandmark(candidate.quadric_map, candidate.extent, latestFitRms(candidate),
+                           T_map_camera) != 0 ||
         sameSurfaceLandmark(candidate, T_map_camera) != 0) {
       kept.push_back(std::move(candidate));
       continue;
@@ -284,13 +291,13 @@ int LandmarkRegistry::sameSurfaceLandmark(const QuadricCandidate& candidate,
 }
 
 int LandmarkRegistry::otherClassLandmark(const QuadricModel& observed,
-                                         const ExtentBox& observed_box,
+                                         const ExtentBox& observed_box, double fit_rms,
                                          const Eigen::Isometry3d& T_map_camera) const {
   const QuadricAssociator::Params& p = associator_.params();
   if (p.cross_class_distance <= 0.0)
     return 0;
   int best = 0;
-  double best_distance = p.cross_class_distance;
+  double best_distance = p.crossClassGate(fit_rms);
   for (const auto& [id, landmark] : landmarks_) {
     if (!crossClassPair(observed, landmark.quadric_map) ||
         !associator_.inRange(landmark.quadric_map, landmarkExtent(landmark), T_map_camera))

@@ -107,6 +107,7 @@ void readMappingParams(const ParamReader& reader, QuadricMapper::Params& mapper,
   readParam(reader, "extent_margin", association.extent_margin, log);
   readParam(reader, "association_max_range", association.max_range, log);
   readParam(reader, "cross_class_distance", association.cross_class_distance, log);
+  readParam(reader, "cross_class_rms_factor", association.cross_class_rms_factor, log);
   LandmarkMerger::Params& merging = map.merging;
   readParam(reader, "merge_landmarks", merging.enabled, log);
   readParam(reader, "merge_gate_probability", merging.gate_probability, log);

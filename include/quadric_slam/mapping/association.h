@@ -49,10 +49,10 @@
 #include <limits>
 #include <vector>
 
-#include "quadric_slam/types/observation.h"
 #include "quadric_slam/geometry/quadric.h"
 #include "quadric_slam/geometry/se3.h"
 #include "quadric_slam/mapping/extent_box.h"
+#include "quadric_slam/types/observation.h"
 
 namespace quadric_slam {
 
@@ -114,6 +114,15 @@ class QuadricAssociator {
     // overlapping as above. It gives no factor (the observation cost compares one class; a general
     // measurement the gate refused would pull its landmark's poorly determined shape).
     double cross_class_distance = 0.02;
+    // ... or within this many times the measurement's own fit RMS, when that is larger (>= 0; 0:
+    // the fixed distance alone). At 2-3 m a depth camera's points scatter by 1-2 cm about their
+    // fit, and a cylinder fitted to the visible band of a cone there leans by 10-25 deg and lies
+    // 3-9 cm from the cone over its box: one frame cannot tell the two surfaces apart closer than
+    // its points' scatter allows.
+    double cross_class_rms_factor = 3.0;
+
+    // The cross-class distance gate for a measurement whose fit has RMS fit_rms (m).
+    double crossClassGate(double fit_rms) const;
 
     // Throws std::invalid_argument naming the bad field and its allowed range.
     void validate() const;

@@ -150,9 +150,10 @@ class LandmarkRegistry {
                           const Eigen::Isometry3d& T_map_camera) const;
   // The landmark of another class (association_cross_class.h: in range of the camera, extents
   // overlapping) whose surface lies nearest to `observed` over the box `observed_box` (in
-  // observed's frame), within association.cross_class_distance; 0 when none.
+  // observed's frame), within the association's cross-class gate for a fit of RMS fit_rms
+  // (QuadricAssociator::Params::crossClassGate); 0 when none.
   int otherClassLandmark(const QuadricModel& observed, const ExtentBox& observed_box,
-                         const Eigen::Isometry3d& T_map_camera) const;
+                         double fit_rms, const Eigen::Isometry3d& T_map_camera) const;
 
   Params params_;
   QuadricAssociator associator_;

@@ -26,7 +26,9 @@ const Eigen::Isometry3d kCamera =
 const Eigen::Vector3d kApex(0.3, 0.5, 1.2);
 const Eigen::Vector3d kAxis = -Eigen::Vector3d::UnitZ();
 constexpr double kHalfAngle = 0.45;
-test::TrueLandmark shade() { return test::cone(kApex, kAxis, kHalfAngle, 0.4); }
+test::TrueLandmark shade() {
+  return test::cone(kApex, kAxis, kHalfAngle, 0.4);
+}
 
 // The cylinder through a band of that cone from s0 to s1 along the axis: coaxial, the cone's
 // radius at the band's middle, the band's height (what a cylinder fit of the band returns).
@@ -52,7 +54,8 @@ TEST(CrossClass, SurfaceDistanceOfACone) {
   // is the double cone; a frame flipped by a symmetry names the other nappe).
   EXPECT_NEAR(distance(Eigen::Vector3d(0, 0, -0.2)), 0.2 * std::sin(0.45), 1e-12);
   EXPECT_NEAR(distance(Eigen::Vector3d(-r, 0, -0.3)), 0.0, 1e-12);
-  const QuadricModel cylinder = quadricFromShape(CylinderShape{Eigen::Vector3d::Zero(), kAxis, 0.1});
+  const QuadricModel cylinder =
+      quadricFromShape(CylinderShape{Eigen::Vector3d::Zero(), kAxis, 0.1});
   EXPECT_NEAR(surfaceDistance(cylinder, cylinder.pose() * Eigen::Vector3d(0.13, 0, 5.0)), 0.03,
               1e-12);
 }
@@ -64,7 +67,8 @@ TEST(CrossClass, CylinderOfAConeBandIsWithinItsSlope) {
   for (double h : {0.05, 0.1, 0.2}) {
     const test::TrueLandmark band = bandAsCylinder(0.25 - 0.5 * h, 0.25 + 0.5 * h);
     const double expected = h * std::sin(kHalfAngle) / std::sqrt(12.0);
-    EXPECT_NEAR(crossClassDistance(band.quadric_world, band.extent, cone), expected, 0.02 * expected)
+    EXPECT_NEAR(crossClassDistance(band.quadric_world, band.extent, cone), expected,
+                0.02 * expected)
         << "band height " << h;
     // The same from the other side: the cone band measured against the cylinder.
     const double s0 = 0.25 - 0.5 * h, s1 = 0.25 + 0.5 * h, r1 = s1 * std::tan(kHalfAngle);
@@ -103,10 +107,10 @@ TEST(CrossClass, CylinderObservationsOfAConeBandCountOnTheCone) {
   ASSERT_EQ(map.landmarks().size(), 1u);
   const int cone_id = map.landmarks().begin()->first;
   for (int frame = 6; frame <= 25; ++frame) {
-    const MapUpdate u = map.integrate(
-        frame, 0.1 * frame,
-        {test::measure(shade(), kCamera, rng), test::measure(bandAsCylinder(0.2, 0.3), kCamera, rng)},
-        kCamera, Matrix6d::Zero());
+    const MapUpdate u = map.integrate(frame, 0.1 * frame,
+                                      {test::measure(shade(), kCamera, rng),
+                                       test::measure(bandAsCylinder(0.2, 0.3), kCamera, rng)},
+                                      kCamera, Matrix6d::Zero());
     EXPECT_EQ(u.measurements[0].fate, MeasurementFate::kLandmark);
     EXPECT_FALSE(u.measurements[0].without_factor);
     EXPECT_EQ(u.measurements[1].fate, MeasurementFate::kLandmark) << "frame " << frame;
@@ -126,10 +130,10 @@ TEST(CrossClass, OffMakesTwoLandmarks) {
   LandmarkRegistry map(params);
   std::mt19937 rng(5);
   for (int frame = 1; frame <= 12; ++frame)
-    map.integrate(
-        frame, 0.1 * frame,
-        {test::measure(shade(), kCamera, rng), test::measure(bandAsCylinder(0.2, 0.3), kCamera, rng)},
-        kCamera, Matrix6d::Zero());
+    map.integrate(frame, 0.1 * frame,
+                  {test::measure(shade(), kCamera, rng),
+                   test::measure(bandAsCylinder(0.2, 0.3), kCamera, rng)},
+                  kCamera, Matrix6d::Zero());
   EXPECT_EQ(map.landmarks().size(), 2u);
 }
 
@@ -140,10 +144,10 @@ TEST(CrossClass, CylinderCandidateIsAbsorbedAtPromotion) {
   std::mt19937 rng(6);
   MapUpdate u;
   for (int frame = 1; frame <= 5; ++frame)
-    u = map.integrate(
-        frame, 0.1 * frame,
-        {test::measure(shade(), kCamera, rng), test::measure(bandAsCylinder(0.2, 0.3), kCamera, rng)},
-        kCamera, Matrix6d::Zero());
+    u = map.integrate(frame, 0.1 * frame,
+                      {test::measure(shade(), kCamera, rng),
+                       test::measure(bandAsCylinder(0.2, 0.3), kCamera, rng)},
+                      kCamera, Matrix6d::Zero());
   ASSERT_EQ(map.landmarks().size(), 1u);
   EXPECT_EQ(map.landmarks().begin()->second.quadric_map.quadricClass(), QuadricClass::kCone);
   EXPECT_EQ(map.landmarks().begin()->second.observations, 10);
@@ -161,8 +165,8 @@ TEST(CrossClass, ConeObservationsOfACylinderCountOnTheCylinder) {
   const double beta = 0.05, s_mid = 0.12 / std::tan(beta);
   const double s0 = s_mid - 0.1, s1 = s_mid + 0.1, r1 = s1 * std::tan(beta);
   const test::TrueLandmark as_cone{
-      quadricFromShape(ConeShape{centre - s_mid * Eigen::Vector3d::UnitZ(),
-                                 Eigen::Vector3d::UnitZ(), beta}),
+      quadricFromShape(
+          ConeShape{centre - s_mid * Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ(), beta}),
       {Eigen::Vector3d(-r1, -r1, s0), Eigen::Vector3d(r1, r1, s1)}};
   LandmarkRegistry map;
   std::mt19937 rng(7);
@@ -277,13 +281,13 @@ test::TrueLandmark ellipsoid(const Eigen::Vector3d& centre, const Eigen::Vector3
 
 // A cushion-like ellipsoid seen from above. A general fit of its top that came out larger (radii
 // +25-50 %, centre lower, the top in place) fails the association gate of the parameters but lies
-// on the landmark over the observed top: it counts on it. An ellipsoid 9 cm beside it (25 cm between
-// centres, outside the association gate) does not.
+// on the landmark over the observed top: it counts on it. An ellipsoid 9 cm beside it (25 cm
+// between centres, outside the association gate) does not.
 TEST(CrossClass, BiasedEllipsoidFitOfAPatchCountsOnItsLandmark) {
   const Eigen::Vector3d c(0.2, 0.6, 0.3);
-  const test::TrueLandmark cushion = ellipsoid(c, Eigen::Vector3d(0.13, 0.08, 0.07),
-                                               {Eigen::Vector3d(-0.13, -0.08, 0.0),
-                                                Eigen::Vector3d(0.13, 0.08, 0.07)});
+  const test::TrueLandmark cushion =
+      ellipsoid(c, Eigen::Vector3d(0.13, 0.08, 0.07),
+                {Eigen::Vector3d(-0.13, -0.08, 0.0), Eigen::Vector3d(0.13, 0.08, 0.07)});
   const test::TrueLandmark biased_top =
       ellipsoid(c - Eigen::Vector3d(0, 0, 0.015), Eigen::Vector3d(0.16, 0.12, 0.085),
                 {Eigen::Vector3d(-0.08, -0.06, 0.06), Eigen::Vector3d(0.08, 0.06, 0.085)});
@@ -310,7 +314,8 @@ TEST(CrossClass, BiasedEllipsoidFitOfAPatchCountsOnItsLandmark) {
       EXPECT_FALSE(u.measurements[2].without_factor);
     }
   }
-  ASSERT_EQ(map.landmarks().size(), 2u);  // the cushion (counting the biased fits) and its neighbour
+  ASSERT_EQ(map.landmarks().size(),
+            2u);  // the cushion (counting the biased fits) and its neighbour
   EXPECT_EQ(map.landmarks().begin()->second.observations, 25);
 }
 
@@ -336,6 +341,31 @@ TEST(CrossClass, MapperKeepsOneConeLandmark) {
   const ConeShape estimate = coneShape(landmarks[0].quadric_map);
   EXPECT_LT((estimate.apex - kApex).norm(), 0.02);
   EXPECT_NEAR(estimate.half_angle, kHalfAngle, 0.02);
+}
+
+// The gate follows the measurement's own scatter: a far view's fit (points 1.5 cm about it) that
+// lies 4 cm off the cone over its box is counted on the cone, as a frame that noisy cannot tell
+// the two surfaces apart; the same surface measured tightly (3 mm) is another surface, a landmark
+// of its own.
+TEST(CrossClass, TheGateFollowsTheMeasurementsScatter) {
+  const test::TrueLandmark sleeve = bandAsCylinder(0.2, 0.3, 0.04);
+  ASSERT_GT(crossClassDistance(sleeve.quadric_world, sleeve.extent, shade().quadric_world), 0.035);
+  QuadricAssociator::Params gate;
+  EXPECT_DOUBLE_EQ(gate.crossClassGate(0.003), gate.cross_class_distance);
+  EXPECT_DOUBLE_EQ(gate.crossClassGate(0.015), 3.0 * 0.015);
+  gate.cross_class_distance = 0.0;  // the test off stays off
+  EXPECT_DOUBLE_EQ(gate.crossClassGate(0.015), 0.0);
+  for (const double fit_rms : {0.015, 0.003}) {
+    LandmarkRegistry map;
+    std::mt19937 rng(9);
+    for (int frame = 1; frame <= 12; ++frame) {
+      QuadricMeasurement far_fit = test::measure(sleeve, kCamera, rng);
+      far_fit.fit_rms = fit_rms;
+      map.integrate(frame, 0.1 * frame, {test::measure(shade(), kCamera, rng), far_fit}, kCamera,
+                    Matrix6d::Zero());
+    }
+    EXPECT_EQ(map.landmarks().size(), fit_rms > 0.01 ? 1u : 2u) << "fit RMS " << fit_rms;
+  }
 }
 
 }  // namespace

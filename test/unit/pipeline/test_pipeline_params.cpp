@@ -191,8 +191,11 @@ TEST(PipelineParams, CorrelatedNoiseKeysAreReadAndValidated) {
                    file["noise_correlation_angle"].as<double>());
   EXPECT_DOUBLE_EQ(mapper.map.association.cross_class_distance,
                    file["cross_class_distance"].as<double>());
+  EXPECT_DOUBLE_EQ(mapper.map.association.cross_class_rms_factor,
+                   file["cross_class_rms_factor"].as<double>());
   for (const auto& [bad, field] : std::vector<std::pair<std::string, std::string>>{
            {"{cross_class_distance: -0.01}", "cross_class_distance"},
+           {"{cross_class_rms_factor: -1}", "cross_class_rms_factor"},
            {"{correlated_noise_fraction: 1.01}", "correlated_noise_fraction"},
            {"{correlated_noise_fraction: -0.1}", "correlated_noise_fraction"},
            {"{noise_correlation_angle: 0}", "noise_correlation_angle"},
