@@ -136,8 +136,19 @@ void QuadricSlam::frontEnd(const RgbdFrame& frame, FrontEndFrame* out) const {
     out->problem = "depth image must be CV_32FC1 metres";
     return;
   }
+  if (!params_.depth_correction.empty() && (params_.depth_correction.width() != k.width ||
+                                            params_.depth_correction.height() != k.height)) {
+    out->problem =
+        "the depth correction spans " + std::to_string(params_.depth_correction.width()) + " x " +
+        std::to_string(params_.depth_correction.height()) + " pixels, not the depth image's " +
+        std::to_string(k.width) + " x " + std::to_string(k.height);
+    return;
+  }
   auto start = Clock::now();
-  normals_.compute(backProject(depthViewOf(frame.depth_m), k, params_.back_projection), out->cloud);
+  pcl::PointCloud<pcl::PointXYZ> points =
+      backProject(depthViewOf(frame.depth_m), k, params_.back_projection);
+  params_.depth_correction.apply(&points, params_.back_projection.decimation);
+  normals_.compute(points, out->cloud);
   out->normals_ms = msSince(start);
   if (!params_.mapping_enabled)
     return;

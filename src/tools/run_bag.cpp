@@ -53,6 +53,7 @@
 
 #include "quadric_slam/eval/resource_usage.h"
 #include "quadric_slam/eval/trajectory_metrics.h"
+#include "quadric_slam/io/depth_correction_yaml.h"
 #include "quadric_slam/io/landmark_map_file.h"
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/io/trajectory_io.h"
@@ -87,6 +88,7 @@ struct Options {
   long max_frames = -1;
   long sample_every = 30;
   qs::CameraIntrinsics intrinsics;             // fx = 0: from the input
+  std::string depth_correction;                // calibrate_depth's file, or empty
   qs::SyntheticFrameSource::Params synthetic;  // a scene INPUT
 };
 
@@ -102,7 +104,7 @@ int usage(const std::string& problem) {
       << "               [--profile NAME|DIR] [--max-frames N] [--intrinsics fx,fy,cx,cy] "
          "[--quiet]\n"
       << "               [--sample-every N] [--no-rgb] [--no-batch] [--seconds S] [--rate HZ]\n"
-      << "               [--seed N] [--sequential] [--stage-threads N]\n"
+      << "               [--seed N] [--sequential] [--stage-threads N] [--depth-correction F]\n"
       << "  INPUT: a TUM rosbag (.bag), a TUM folder (rgb.txt, depth.txt, depth/), or a scene\n"
       << "         file (config/scenes/*.yaml) rendered frame by frame: --seconds (default 60),\n"
       << "         --rate (default: the scene's), --seed (default 1) apply to it\n"
@@ -120,7 +122,9 @@ int usage(const std::string& problem) {
       << "                own meanwhile; the results are the same)\n"
       << "  --stage-threads N: worker threads inside the normal estimation and the segmentation\n"
       << "                (default: 1 when pipelined, where the pipeline's own threads already\n"
-      << "                use the cores; the configured `threads` keys with --sequential)\n";
+      << "                use the cores; the configured `threads` keys with --sequential)\n"
+      << "  --depth-correction F: undo the sensor's fixed depth distortion with F, written by\n"
+      << "                scripts/calibrate_depth (frontend/depth_correction.h)\n";
   return 2;
 }
 
@@ -168,6 +172,8 @@ bool parseOptions(int argc, char** argv, Options& o, std::string& problem) {
         o.synthetic.rate = std::stod(value());
       } else if (arg == "--seed") {
         o.synthetic.seed = std::stoull(value());
+      } else if (arg == "--depth-correction") {
+        o.depth_correction = value();
       } else if (arg == "--intrinsics") {
         if (!qs::parseIntrinsics(value(), o.intrinsics))
           throw std::invalid_argument("--intrinsics takes fx,fy,cx,cy");
@@ -327,6 +333,8 @@ int main(int argc, char** argv) {
       params.normals.threads = o.stage_threads;
       params.segmentation.threads = o.stage_threads;
     }
+    if (!o.depth_correction.empty())
+      params.depth_correction = qs::readDepthCorrectionYaml(o.depth_correction);
     const bool batch = params.batch_refinement;
     qs::QuadricSlam slam(params);
 

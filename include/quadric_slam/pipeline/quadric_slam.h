@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "quadric_slam/eval/stage_timing.h"
+#include "quadric_slam/frontend/depth_correction.h"
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/frontend/quadric_segmenter.h"
@@ -51,6 +52,10 @@ namespace quadric_slam {
 
 struct SlamParams {
   BackProjectionParams back_projection;
+  // The sensor's fixed depth distortion, undone on every frame before the normals (empty: none;
+  // frontend/depth_correction.h, estimated by the calibrate_depth tool). It must span the depth
+  // images' size, else the frames are skipped with the problem named.
+  DepthCorrection depth_correction;
   NormalEstimator::Params normals;
   QuadricSegmenter::Params segmentation;
   OdometryTracker::Params odometry;
