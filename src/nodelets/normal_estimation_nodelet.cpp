@@ -8,6 +8,9 @@
 //             does not hold back the depth stream — the image is dropped only until a valid one
 //             has been received)
 // Parameters  config/normal_estimation.yaml (every key documented there)
+//             ~depth_correction (string, default ""): a file of scripts/calibrate_depth; the
+//             sensor's fixed depth distortion is undone before the normals (a depth image of
+//             another size than the file's is dropped with the reason)
 // Publishes   points_normals (sensor_msgs/PointCloud2, organized, fields x y z normal_x normal_y
 //             normal_z curvature, NaN where there is no data, the depth image's stamp; frame
 //             ~output_frame, or the image's frame id when that is empty, without a leading '/')
@@ -27,14 +30,16 @@
 #include <memory>
 #include <mutex>
 
+#include "quadric_slam/frontend/depth_correction.h"
 #include "quadric_slam/frontend/frame.h"
 #include "quadric_slam/frontend/normal_estimator.h"
+#include "quadric_slam/io/depth_correction_yaml.h"
 #include "quadric_slam/pipeline/pipeline_params.h"
 #include "quadric_slam/ros/depth_image.h"
 #include "quadric_slam/ros/diagnostics.h"
 #include "quadric_slam/ros/drop_reporter.h"
-#include "quadric_slam/ros/message_validation.h"
 #include "quadric_slam/ros/frame_ids.h"
+#include "quadric_slam/ros/message_validation.h"
 #include "quadric_slam/ros/params.h"
 
 namespace quadric_slam {
@@ -53,9 +58,16 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
       readNormalEstimationParams(params, back_projection_, normal_params, log);
       readFrameParam(params, "output_frame", output_frame_, log);
       readParam(params, "queue_size", queue_size, log);
+      std::string correction_file;
+      readParam(params, "depth_correction", correction_file, log);
+      if (!correction_file.empty())
+        depth_correction_ = readDepthCorrectionYaml(correction_file);
       estimator_ = std::make_unique<NormalEstimator>(normal_params);
     } catch (const std::invalid_argument& e) {
       NODELET_FATAL("normal_estimation: invalid parameter: %s", e.what());
+      throw;
+    } catch (const std::runtime_error& e) {
+      NODELET_FATAL("normal_estimation: depth_correction: %s", e.what());
       throw;
     }
     NODELET_INFO("normal_estimation parameters:%s", log.str().c_str());
@@ -110,6 +122,16 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
       drop(problem);
       return;
     }
+    if (!depth_correction_.empty()) {
+      if (depth_correction_.width() != static_cast<int>(image->width) ||
+          depth_correction_.height() != static_cast<int>(image->height)) {
+        drop("depth image " + std::to_string(image->width) + " x " + std::to_string(image->height) +
+             " is not the depth correction's " + std::to_string(depth_correction_.width()) + " x " +
+             std::to_string(depth_correction_.height()));
+        return;
+      }
+      depth_correction_.apply(&cloud, back_projection_.decimation);
+    }
     estimator_->compute(cloud, with_normals_);
     auto msg = boost::make_shared<sensor_msgs::PointCloud2>();
     pcl::toROSMsg(with_normals_, *msg);
@@ -124,7 +146,8 @@ class NormalEstimationNodelet : public nodelet::Nodelet {
   void drop(const std::string& reason) { depth_drops_->drop(reason); }
 
   BackProjectionParams back_projection_;
-  std::string output_frame_;  // "" = the image's frame
+  DepthCorrection depth_correction_;  // empty: none
+  std::string output_frame_;          // "" = the image's frame
   std::unique_ptr<NormalEstimator> estimator_;
   // Output storage reused from frame to frame (a subscription's callbacks never run concurrently).
   pcl::PointCloud<pcl::PointNormal> with_normals_;
