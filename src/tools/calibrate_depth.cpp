@@ -6,19 +6,16 @@
 // RMS before and after the correction.
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
 
 #include "quadric_slam/frontend/depth_correction_estimator.h"
 #include "quadric_slam/io/depth_correction_yaml.h"
-#include "quadric_slam/io/tum_folder_reader.h"
 #include "quadric_slam/pipeline/quadric_slam.h"
-#include "quadric_slam/ros/tum_bag_reader.h"
+#include "quadric_slam/ros/recording_source.h"
 
 namespace qs = quadric_slam;
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -97,25 +94,6 @@ bool parseOptions(int argc, char** argv, Options& o, std::string& problem) {
   return problem.empty();
 }
 
-std::unique_ptr<qs::FrameSource> openInput(const Options& o) {
-  if (fs::is_directory(o.input)) {
-    qs::TumFolderReader::Params params;
-    params.load_rgb = false;
-    if (o.intrinsics.fx > 0)
-      params.intrinsics = o.intrinsics;
-    return std::make_unique<qs::TumFolderReader>(o.input, params);
-  }
-  if (fs::is_regular_file(o.input)) {
-    qs::TumBagReader::Params params;
-    params.rgb_topic.clear();
-    params.keep_frames_without_rgb = true;
-    if (o.intrinsics.fx > 0)
-      params.intrinsics = o.intrinsics;
-    return std::make_unique<qs::TumBagReader>(o.input, params);
-  }
-  throw std::runtime_error("INPUT " + o.input + " is neither a TUM folder nor a bag file");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -129,7 +107,8 @@ int main(int argc, char** argv) {
     qs::QuadricSegmenter segmenter(params.segmentation);
     qs::BackProjectionParams back_projection = params.back_projection;
     back_projection.decimation = 1;  // the segments' pixels at full resolution
-    std::unique_ptr<qs::FrameSource> source = openInput(o);
+    std::unique_ptr<qs::FrameSource> source =
+        qs::openRecording(o.input, qs::RecordingOptions{false, o.intrinsics});
     std::unique_ptr<qs::DepthCorrectionEstimator> estimator;
     qs::RgbdFrame frame;
     long index = 0, used_frames = 0;

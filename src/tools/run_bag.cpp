@@ -57,10 +57,9 @@
 #include "quadric_slam/io/landmark_map_file.h"
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/io/trajectory_io.h"
-#include "quadric_slam/io/tum_folder_reader.h"
 #include "quadric_slam/pipeline/quadric_slam.h"
 #include "quadric_slam/ros/reconstruction_cloud.h"
-#include "quadric_slam/ros/tum_bag_reader.h"
+#include "quadric_slam/ros/recording_source.h"
 #include "quadric_slam/sim/scene_yaml.h"
 #include "quadric_slam/sim/synthetic_frame_source.h"
 
@@ -205,27 +204,8 @@ std::unique_ptr<qs::FrameSource> openInput(const Options& o) {
     params.rgb = o.rgb;  // colours the reconstruction only
     return std::make_unique<qs::SyntheticFrameSource>(scene, params);
   }
-  if (fs::is_directory(o.input)) {
-    qs::TumFolderReader::Params params;
-    // RGB (registered to depth, paired by stamp: io/stamp_association.h) colours the
-    // reconstruction only; a depth frame without an RGB partner runs uncoloured, so the frames and
-    // the map are those of a depth-only run.
-    params.load_rgb = o.rgb && fs::is_regular_file(fs::path(o.input) / "rgb.txt");
-    params.keep_frames_without_rgb = true;
-    if (o.intrinsics.fx > 0)
-      params.intrinsics = o.intrinsics;
-    return std::make_unique<qs::TumFolderReader>(o.input, params);
-  }
-  if (fs::is_regular_file(o.input)) {
-    qs::TumBagReader::Params params;
-    if (!o.rgb)
-      params.rgb_topic.clear();             // depth only
-    params.keep_frames_without_rgb = true;  // as for a folder: the same frames with or without RGB
-    if (o.intrinsics.fx > 0)
-      params.intrinsics = o.intrinsics;
-    return std::make_unique<qs::TumBagReader>(o.input, params);
-  }
-  throw std::runtime_error("INPUT " + o.input + " is neither a TUM folder nor a bag file");
+  // RGB (registered to depth) colours the reconstruction only.
+  return qs::openRecording(o.input, qs::RecordingOptions{o.rgb, o.intrinsics});
 }
 
 // Prints <prefix>ate_rmse_m, <prefix>pairs and <prefix>rpe_m_per_s.
