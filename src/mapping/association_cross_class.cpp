@@ -64,10 +64,12 @@ std::vector<Eigen::Vector3d> surfacePointsInBox(const QuadricModel& observed,
 
 bool crossClassPair(const QuadricModel& observed, const QuadricModel& target) {
   const QuadricClass o = observed.quadricClass(), t = target.quadricClass();
+  // Axial classes and spheres against their own class too: a partial view (a cone's upper band, a
+  // cylinder's narrow strip) fits a shape whose parameters fail the gate of a landmark it lies on.
   if (isAxial(o) && isAxial(t))
-    return o != t;
+    return true;
   if (o == QuadricClass::kSphere)
-    return isAxial(t) || t == QuadricClass::kGeneral;
+    return isAxial(t) || t == QuadricClass::kGeneral || t == QuadricClass::kSphere;
   // An ellipsoid against any curved landmark, general ones included: a general fit of part of a
   // surface is poorly determined (its minimal-space covariance misses the shape's model error),
   // so two fits of one patch can fail the association gate yet lie on each other.

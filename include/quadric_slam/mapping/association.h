@@ -110,8 +110,9 @@ class QuadricAssociator {
     // A measurement left unmatched by the landmarks of its class is counted on a landmark of
     // another class whose surface lies within this RMS distance of the observed surface over its
     // box (m, >= 0; 0 turns the test off; pairs in mapping/association_cross_class.h: cylinder <->
-    // cone, sphere -> cylinder, cone, general, ellipsoid -> any curved landmark), extents
-    // overlapping as above. It gives no factor (the observation cost compares one class; a general
+    // cone, sphere -> cylinder, cone, general, ellipsoid -> any curved landmark; and cylinders,
+    // cones and spheres with their own class: a partial view whose parameters the gate refused),
+    // extents overlapping as above. It gives no factor (the observation cost compares one class; a general
     // measurement the gate refused would pull its landmark's poorly determined shape).
     double cross_class_distance = 0.02;
     // ... or within this many times the measurement's own fit RMS, when that is larger (>= 0; 0:

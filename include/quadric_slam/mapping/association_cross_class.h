@@ -10,7 +10,10 @@
 // Pairs compared (observed -> landmark): cylinder <-> cone; sphere -> cylinder, cone, general;
 // ellipsoid (general, signature +++-) -> sphere, cylinder, cone, general (a general fit of part of
 // a surface is poorly determined: two fits of one patch can fail the gate of their parameters yet
-// lie on each other).
+// lie on each other). The same holds within a class: a partial view of a cone (its upper band, a
+// few thousand pixels) or of a cylinder fits a shape whose parameters fail the association gate of
+// the landmark it lies on, so cylinders, cones and spheres are also compared with landmarks of
+// their own class here (only measurements the parameter gate refused reach this test).
 #pragma once
 
 #include <Eigen/Geometry>

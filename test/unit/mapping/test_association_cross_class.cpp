@@ -80,8 +80,11 @@ TEST(CrossClass, CylinderOfAConeBandIsWithinItsSlope) {
   // A sleeve 4 cm outside the band: cos(half-angle) 4 cm away.
   const test::TrueLandmark sleeve = bandAsCylinder(0.2, 0.3, 0.04);
   EXPECT_GT(crossClassDistance(sleeve.quadric_world, sleeve.extent, cone), 0.035);
-  // Same class or no box: no comparison.
-  EXPECT_TRUE(std::isinf(crossClassDistance(cone, shade().extent, cone)));
+  // Within a class the surfaces are compared too (a partial view against its landmark); a plane
+  // never, and no box means no comparison.
+  EXPECT_NEAR(crossClassDistance(cone, shade().extent, cone), 0.0, 1e-9);
+  const QuadricModel floor = quadricFromShape(PlaneShape{Eigen::Vector3d::UnitZ(), 0.0});
+  EXPECT_TRUE(std::isinf(crossClassDistance(floor, shade().extent, floor)));
   EXPECT_TRUE(std::isinf(crossClassDistance(sleeve.quadric_world, ExtentBox{}, cone)));
 }
 
@@ -366,6 +369,42 @@ TEST(CrossClass, TheGateFollowsTheMeasurementsScatter) {
     }
     EXPECT_EQ(map.landmarks().size(), fit_rms > 0.01 ? 1u : 2u) << "fit RMS " << fit_rms;
   }
+}
+
+// Within a class: a partial view of the cone (a band 5 cm high) fitted with its apex 15 cm higher
+// and a smaller half-angle, so that the band lies on the cone while the parameters are far outside
+// the association gate, counts on the cone landmark without a factor instead of starting a second
+// cone landmark.
+TEST(CrossClass, APartialViewWhoseParametersFailTheGateCountsOnItsLandmark) {
+  const double s0 = 0.25, s1 = 0.3, s_mid = 0.5 * (s0 + s1), shift = 0.15;
+  // The band's cone: apex `shift` up the axis, radius at the band's middle the shade's.
+  const double beta = std::atan(s_mid * std::tan(kHalfAngle) / (s_mid + shift));
+  const double r1 = (s1 + shift) * std::tan(beta);
+  const test::TrueLandmark band{
+      quadricFromShape(ConeShape{kApex - shift * kAxis, kAxis, beta}),
+      {Eigen::Vector3d(-r1, -r1, s0 + shift), Eigen::Vector3d(r1, r1, s1 + shift)}};
+  ASSERT_LT(crossClassDistance(band.quadric_world, band.extent, shade().quadric_world), 0.01);
+  LandmarkRegistry map;
+  std::mt19937 rng(10);
+  for (int frame = 1; frame <= 5; ++frame)
+    map.integrate(frame, 0.1 * frame, {test::measure(shade(), kCamera, rng)}, kCamera,
+                  Matrix6d::Zero());
+  ASSERT_EQ(map.landmarks().size(), 1u);
+  const int cone_id = map.landmarks().begin()->first;
+  for (int frame = 6; frame <= 20; ++frame) {
+    // A fit of a few thousand pixels: its covariance (pixel noise) as tight as its scatter.
+    QuadricMeasurement partial = test::measure(band, kCamera, rng, 0.01);
+    partial.covariance *= 1e-4;
+    const MapUpdate u = map.integrate(frame, 0.1 * frame, {partial}, kCamera, Matrix6d::Zero());
+    ASSERT_EQ(u.measurements.size(), 1u);
+    EXPECT_NE(u.measurements[0].landmark_association.outcome, AssociationOutcome::kMatched)
+        << "frame " << frame << ": the band's parameters should fail the gate";
+    EXPECT_EQ(u.measurements[0].fate, MeasurementFate::kLandmark) << "frame " << frame;
+    EXPECT_EQ(u.measurements[0].id, cone_id);
+    EXPECT_TRUE(u.measurements[0].without_factor);
+  }
+  EXPECT_EQ(map.landmarks().size(), 1u);
+  EXPECT_TRUE(map.candidates().empty());
 }
 
 }  // namespace
