@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -64,7 +65,9 @@ double DepthCorrection::offsetAt(double u, double v) const {
 double DepthCorrection::correctedDepth(double u, double v, double z_measured) const {
   if (empty() || !std::isfinite(z_measured) || z_measured <= 0.0)
     return z_measured;
-  return focal_baseline_ / (focal_baseline_ / z_measured + offsetAt(u, v));
+  const double disparity = focal_baseline_ / z_measured + offsetAt(u, v);
+  // A corrected disparity at or below zero is beyond infinity: no depth.
+  return disparity > 0.0 ? focal_baseline_ / disparity : std::numeric_limits<double>::quiet_NaN();
 }
 
 void DepthCorrection::apply(pcl::PointCloud<pcl::PointXYZ>* cloud, int decimation) const {
@@ -85,8 +88,12 @@ void DepthCorrection::apply(pcl::PointCloud<pcl::PointXYZ>* cloud, int decimatio
         continue;
       const double offset =
           pixel_offsets_[static_cast<std::size_t>(row * step) * width_ + col * step];
-      const double z = focal_baseline_ / (focal_baseline_ / p.z + offset);
-      const float scale = static_cast<float>(z / p.z);
+      const double disparity = focal_baseline_ / p.z + offset;
+      if (!(disparity > 0.0)) {  // beyond infinity once corrected: no depth
+        p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      const float scale = static_cast<float>(focal_baseline_ / disparity / p.z);
       p.x *= scale;
       p.y *= scale;
       p.z *= scale;

@@ -42,12 +42,13 @@ class DepthCorrection {
 
   // D(u, v): bilinear between the nodes (px); pixels outside the image take the border's.
   double offsetAt(double u, double v) const;
-  // The corrected depth of a pixel measured at z' (m); z' itself when empty() or not finite.
+  // The corrected depth of a pixel measured at z' (m); z' itself when empty() or not finite; NaN
+  // when the corrected disparity is not positive (a negative offset larger than the disparity).
   double correctedDepth(double u, double v, double z_measured) const;
   // Moves every finite point of an organized cloud back-projected with the given decimation
   // (point (col, row) from pixel (col decimation, row decimation)) along its ray to the corrected
-  // depth. Nothing when empty(). Throws std::invalid_argument when the cloud's full-resolution
-  // size is not the correction's image.
+  // depth (no data where the corrected disparity is not positive). Nothing when empty(). Throws
+  // std::invalid_argument when the cloud's full-resolution size is not the correction's image.
   void apply(pcl::PointCloud<pcl::PointXYZ>* cloud, int decimation) const;
 
  private:

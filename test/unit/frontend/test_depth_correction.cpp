@@ -97,6 +97,21 @@ TEST(DepthCorrection, UndoesTheDistortionItHolds) {
   EXPECT_EQ(copy(10, 10).z, cloud(10, 10).z);
 }
 
+// A negative offset larger than a far point's disparity: no depth, not a negative one.
+TEST(DepthCorrection, BeyondInfinityIsNoData) {
+  const DepthCorrection correction(kWidth, kHeight, 2, 2, std::vector<double>(4, -5.0),
+                                   kFocalBaseline);
+  EXPECT_TRUE(std::isnan(correction.correctedDepth(100, 100, 9.0)));  // disparity 4.4 px
+  EXPECT_NEAR(correction.correctedDepth(100, 100, 2.0),
+              kFocalBaseline / (kFocalBaseline / 2.0 - 5.0), 1e-12);
+  pcl::PointCloud<pcl::PointXYZ> cloud(kWidth, kHeight);
+  cloud(3, 4) = pcl::PointXYZ(1.0f, 1.0f, 9.0f);
+  cloud(5, 4) = pcl::PointXYZ(0.1f, 0.1f, 2.0f);
+  correction.apply(&cloud, 1);
+  EXPECT_TRUE(std::isnan(cloud(3, 4).z));
+  EXPECT_NEAR(cloud(5, 4).z, kFocalBaseline / (kFocalBaseline / 2.0 - 5.0), 1e-4);
+}
+
 TEST(DepthCorrection, RejectsBadGrids) {
   EXPECT_THROW(DepthCorrection(kWidth, kHeight, 1, 5, std::vector<double>(5, 0.0), kFocalBaseline),
                std::invalid_argument);
