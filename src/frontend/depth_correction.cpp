@@ -7,6 +7,16 @@
 #include <utility>
 
 namespace quadric_slam {
+namespace {
+
+// z = f b / (f b / z' + D): the measured depth z' moved by the disparity offset D. A corrected
+// disparity at or below zero is beyond infinity: no depth (NaN).
+double depthFromCorrectedDisparity(double focal_baseline, double offset, double z_measured) {
+  const double disparity = focal_baseline / z_measured + offset;
+  return disparity > 0.0 ? focal_baseline / disparity : std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
 
 GridWeights gridWeights(double u, double v, int width, int height, int cols, int rows) {
   const double x = std::clamp(u, 0.0, width - 1.0) * (cols - 1) / (width - 1.0);
@@ -65,9 +75,7 @@ double DepthCorrection::offsetAt(double u, double v) const {
 double DepthCorrection::correctedDepth(double u, double v, double z_measured) const {
   if (empty() || !std::isfinite(z_measured) || z_measured <= 0.0)
     return z_measured;
-  const double disparity = focal_baseline_ / z_measured + offsetAt(u, v);
-  // A corrected disparity at or below zero is beyond infinity: no depth.
-  return disparity > 0.0 ? focal_baseline_ / disparity : std::numeric_limits<double>::quiet_NaN();
+  return depthFromCorrectedDisparity(focal_baseline_, offsetAt(u, v), z_measured);
 }
 
 void DepthCorrection::apply(pcl::PointCloud<pcl::PointXYZ>* cloud, int decimation) const {
@@ -88,12 +96,12 @@ void DepthCorrection::apply(pcl::PointCloud<pcl::PointXYZ>* cloud, int decimatio
         continue;
       const double offset =
           pixel_offsets_[static_cast<std::size_t>(row * step) * width_ + col * step];
-      const double disparity = focal_baseline_ / p.z + offset;
-      if (!(disparity > 0.0)) {  // beyond infinity once corrected: no depth
+      const double z = depthFromCorrectedDisparity(focal_baseline_, offset, p.z);
+      if (!std::isfinite(z)) {
         p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
         continue;
       }
-      const float scale = static_cast<float>(focal_baseline_ / disparity / p.z);
+      const float scale = static_cast<float>(z / p.z);
       p.x *= scale;
       p.y *= scale;
       p.z *= scale;

@@ -64,14 +64,17 @@ int DepthCorrectionEstimator::addPlane(const std::vector<Eigen::Vector2d>& pixel
       b += f * disparity(i);
     }
     const Eigen::Vector3d plane = a.ldlt().solve(b);
+    std::vector<double> residuals(used.size());
     double sum_sq = 0.0;
-    for (int i : used)
-      sum_sq += std::pow(disparity(i) - features(i).dot(plane), 2);
+    for (std::size_t k = 0; k < used.size(); ++k) {
+      residuals[k] = disparity(used[k]) - features(used[k]).dot(plane);
+      sum_sq += residuals[k] * residuals[k];
+    }
     const double limit = params_.outlier_sigmas * std::sqrt(sum_sq / used.size());
     std::vector<int> kept;
-    for (int i : used)
-      if (std::abs(disparity(i) - features(i).dot(plane)) <= limit)
-        kept.push_back(i);
+    for (std::size_t k = 0; k < used.size(); ++k)
+      if (std::abs(residuals[k]) <= limit)
+        kept.push_back(used[k]);
     used.swap(kept);
   }
   if (static_cast<int>(used.size()) < params_.min_pixels)

@@ -55,7 +55,7 @@ class DepthCorrectionEstimator {
   // std::runtime_error when no segment was added.
   DepthCorrection solve() const;
   // RMS of the segments' disparity residuals (px) before and after the correction, over the data
-  // added (computed by solve() from the accumulated sums).
+  // added; computed from the accumulated sums (S0 - 2 b.D + D.H.D), no pixel is revisited.
   struct Fit {
     double rms_before = 0.0;
     double rms_after = 0.0;
