@@ -57,6 +57,7 @@
 #include "quadric_slam/io/landmark_map_file.h"
 #include "quadric_slam/io/map_yaml.h"
 #include "quadric_slam/io/trajectory_io.h"
+#include "quadric_slam/pipeline/memory_reuse.h"
 #include "quadric_slam/pipeline/quadric_slam.h"
 #include "quadric_slam/ros/reconstruction_cloud.h"
 #include "quadric_slam/ros/recording_source.h"
@@ -296,6 +297,9 @@ int main(int argc, char** argv) {
   std::string problem;
   if (!parseOptions(argc, argv, o, problem))
     return usage(problem);
+  if (!qs::keepFreedMemoryForReuse())
+    std::fprintf(stderr,
+                 "run_bag: the allocator keeps its defaults (frames fault their pages in)\n");
 
   try {
     const std::string profile_dir = qs::profileDirectory(o.config_dir, o.profile);
