@@ -110,7 +110,7 @@ class QuadricSegmenter {
     // Every cgal_stride-th free pixel in u and v goes to CGAL, [1, 16]. Default 3.
     int cgal_stride = 3;
     // A larger stride is used in a component that would give CGAL more points than this, >= 100.
-    int cgal_max_points = 2000;
+    int cgal_max_points = 500;
     // CGAL Efficient RANSAC: probability of missing the largest shape, (0, 1); minimum support
     // (sub-sampled points), >= 4; distance epsilon (m), > 0; cluster epsilon (m), > 0; normal
     // threshold (cosine), (0, 1).
