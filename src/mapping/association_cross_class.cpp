@@ -62,7 +62,7 @@ std::vector<Eigen::Vector3d> surfacePointsInBox(const QuadricModel& observed,
 
 }  // namespace
 
-bool crossClassPair(const QuadricModel& observed, const QuadricModel& target) {
+bool surfaceTestApplies(const QuadricModel& observed, const QuadricModel& target) {
   const QuadricClass o = observed.quadricClass(), t = target.quadricClass();
   // Axial classes and spheres against their own class too: a partial view (a cone's upper band, a
   // cylinder's narrow strip) fits a shape whose parameters fail the gate of a landmark it lies on.
@@ -79,7 +79,7 @@ bool crossClassPair(const QuadricModel& observed, const QuadricModel& target) {
 double crossClassDistance(const QuadricModel& observed, const ExtentBox& box,
                           const QuadricModel& target) {
   const double inf = std::numeric_limits<double>::infinity();
-  if (!crossClassPair(observed, target) || !box.known())
+  if (!surfaceTestApplies(observed, target) || !box.known())
     return inf;
   double sum = 0.0;
   int n = 0;

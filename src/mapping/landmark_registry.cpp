@@ -299,7 +299,7 @@ int LandmarkRegistry::otherClassLandmark(const QuadricModel& observed,
   int best = 0;
   double best_distance = p.crossClassGate(fit_rms);
   for (const auto& [id, landmark] : landmarks_) {
-    if (!crossClassPair(observed, landmark.quadric_map) ||
+    if (!surfaceTestApplies(observed, landmark.quadric_map) ||
         !associator_.inRange(landmark.quadric_map, landmarkExtent(landmark), T_map_camera))
       continue;
     const ExtentBox moved =

@@ -112,8 +112,8 @@ class QuadricAssociator {
     // box (m, >= 0; 0 turns the test off; pairs in mapping/association_cross_class.h: cylinder <->
     // cone, sphere -> cylinder, cone, general, ellipsoid -> any curved landmark; and cylinders,
     // cones and spheres with their own class: a partial view whose parameters the gate refused),
-    // extents overlapping as above. It gives no factor (the observation cost compares one class; a general
-    // measurement the gate refused would pull its landmark's poorly determined shape).
+    // extents overlapping as above. It gives no factor (the observation cost compares one class;
+    // a general measurement the gate refused would pull its landmark's poorly determined shape).
     double cross_class_distance = 0.02;
     // ... or within this many times the measurement's own fit RMS, when that is larger (>= 0; 0:
     // the fixed distance alone). At 2-3 m a depth camera's points scatter by 1-2 cm about their

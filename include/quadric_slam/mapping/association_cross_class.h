@@ -25,7 +25,7 @@ namespace quadric_slam {
 
 // True when a measurement of `observed`'s class may be counted on a landmark of `target`'s class
 // through the surface test (the pairs above).
-bool crossClassPair(const QuadricModel& observed, const QuadricModel& target);
+bool surfaceTestApplies(const QuadricModel& observed, const QuadricModel& target);
 
 // RMS distance (m) from the surface of `observed` (in frame M), over its box of supporting points
 // `observed_box` (in the observed quadric's frame), to the surface of `target` (in frame M).

@@ -38,6 +38,15 @@ test::TrueLandmark bandAsCylinder(double s0, double s1, double radius_offset = 0
                         0.5 * (s1 - s0));
 }
 
+// Maps the cone from five frames that see it alone; returns its landmark's id.
+int mapTheCone(LandmarkRegistry& map, std::mt19937& rng) {
+  for (int frame = 1; frame <= 5; ++frame)
+    map.integrate(frame, 0.1 * frame, {test::measure(shade(), kCamera, rng)}, kCamera,
+                  Matrix6d::Zero());
+  EXPECT_EQ(map.landmarks().size(), 1u);
+  return map.landmarks().empty() ? -1 : map.landmarks().begin()->first;
+}
+
 // The landmark's surface distance (geometry/surface_distance.h, points in the parent frame) on a
 // cone's double nappe, as the cross-class test uses it.
 TEST(CrossClass, SurfaceDistanceOfACone) {
@@ -104,11 +113,8 @@ TEST(CrossClass, ParamIsValidated) {
 TEST(CrossClass, CylinderObservationsOfAConeBandCountOnTheCone) {
   LandmarkRegistry map;
   std::mt19937 rng(5);
-  for (int frame = 1; frame <= 5; ++frame)
-    map.integrate(frame, 0.1 * frame, {test::measure(shade(), kCamera, rng)}, kCamera,
-                  Matrix6d::Zero());
+  const int cone_id = mapTheCone(map, rng);
   ASSERT_EQ(map.landmarks().size(), 1u);
-  const int cone_id = map.landmarks().begin()->first;
   for (int frame = 6; frame <= 25; ++frame) {
     const MapUpdate u = map.integrate(frame, 0.1 * frame,
                                       {test::measure(shade(), kCamera, rng),
@@ -386,11 +392,8 @@ TEST(CrossClass, APartialViewWhoseParametersFailTheGateCountsOnItsLandmark) {
   ASSERT_LT(crossClassDistance(band.quadric_world, band.extent, shade().quadric_world), 0.01);
   LandmarkRegistry map;
   std::mt19937 rng(10);
-  for (int frame = 1; frame <= 5; ++frame)
-    map.integrate(frame, 0.1 * frame, {test::measure(shade(), kCamera, rng)}, kCamera,
-                  Matrix6d::Zero());
+  const int cone_id = mapTheCone(map, rng);
   ASSERT_EQ(map.landmarks().size(), 1u);
-  const int cone_id = map.landmarks().begin()->first;
   for (int frame = 6; frame <= 20; ++frame) {
     // A fit of a few thousand pixels: its covariance (pixel noise) as tight as its scatter.
     QuadricMeasurement partial = test::measure(band, kCamera, rng, 0.01);
