@@ -6,9 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <vector>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace quadric_slam {
 namespace {
@@ -16,6 +16,30 @@ namespace {
 // ICP puts degenerate_variance along the directions it could not constrain; sigma^2 H^-1 on the
 // others is orders of magnitude smaller, so any fraction between them finds the same free ones.
 constexpr double kFreeVarianceFraction = 0.5;
+// The camera-speed bound on the corners' guesses is at least this (m, rad): a frame's stamp may
+// be jittered, and at 30 Hz the bound itself would be a few centimetres.
+constexpr double kMinSpeedBoundTranslation = 0.1;
+constexpr double kMinSpeedBoundRotation = 0.2;
+// Placing a frame by the corners alone needs this many times min_inliers, and this share of the
+// matches, agreeing.
+constexpr int kPlacementInlierFactor = 2;
+constexpr double kPlacementInlierShare = 0.5;
+// A degenerate pose must keep this share of the keyframe's corners' agreeing matches.
+constexpr double kCornerAgreementShare = 0.5;
+
+// The organized cloud's depths (m; 0 where none), for lifting image corners to 3D.
+cv::Mat depthOf(const OdometryTracker::Cloud& cloud) {
+  cv::Mat depth(static_cast<int>(cloud.height), static_cast<int>(cloud.width), CV_32FC1);
+  float* out = depth.ptr<float>();
+  for (const auto& p : cloud.points)
+    *out++ = std::isfinite(p.z) ? p.z : 0.0f;
+  return depth;
+}
+
+bool usableImage(const cv::Mat* image, const CameraIntrinsics& intrinsics) {
+  return image && !image->empty() && image->cols == intrinsics.width &&
+         image->rows == intrinsics.height && (image->type() == CV_8UC1 || image->type() == CV_8UC3);
+}
 
 }  // namespace
 
@@ -47,6 +71,19 @@ void OdometryTracker::Params::validate() const {
   if (!(increment_rotation_per_metre >= 0 && std::isfinite(increment_rotation_per_metre)))
     check.fail("increment_rotation_per_metre", "[0, inf) rad/m", increment_rotation_per_metre);
   guess.validate();
+  features.validate();
+  if (feature_history_keyframes < 0 || feature_history_keyframes > 1000)
+    check.fail("feature_history_keyframes", "[0, 1000]", feature_history_keyframes);
+  if (!(feature_pose_sigma_translation > 0 && std::isfinite(feature_pose_sigma_translation)))
+    check.fail("feature_pose_sigma_translation", "(0, inf) m", feature_pose_sigma_translation);
+  if (!(feature_pose_sigma_rotation > 0 && feature_pose_sigma_rotation <= M_PI))
+    check.fail("feature_pose_sigma_rotation", "(0, pi] rad", feature_pose_sigma_rotation);
+  if (!(feature_min_interval >= 0 && std::isfinite(feature_min_interval)))
+    check.fail("feature_min_interval", "[0, inf) s", feature_min_interval);
+  if (!(feature_max_speed > 0 && std::isfinite(feature_max_speed)))
+    check.fail("feature_max_speed", "(0, inf) m/s", feature_max_speed);
+  if (!(feature_max_turn_rate > 0 && std::isfinite(feature_max_turn_rate)))
+    check.fail("feature_max_turn_rate", "(0, inf) rad/s", feature_max_turn_rate);
   surface_normals.validate();
   photometric.validate();
   if (!(photometric_information_scale > 0 && photometric_information_scale <= 1))
@@ -62,6 +99,7 @@ OdometryTracker::OdometryTracker(const Params& params)
     : params_((params.validate(), params)),
       icp_(params.icp),
       guesser_(params.guess),
+      feature_guesser_(params.features),
       photometric_(params.photometric) {}
 
 int OdometryTracker::adoptSurfaceNormals(const std::vector<QuadricMeasurement>& observations,
@@ -76,6 +114,10 @@ void OdometryTracker::reset() {
   icp_.clearReference();
   keyframe_observations_.clear();
   keyframe_intensity_ = IntensityPyramid();
+  keyframe_features_ = FeatureFrame();
+  keyframe_image_.release();
+  keyframe_depth_.release();
+  feature_history_.clear();
   T_odom_keyframe_ = T_odom_camera_ = last_motion_ = Eigen::Isometry3d::Identity();
   keyframe_covariance_ = covariance_ = keyframe_relative_covariance_ = Matrix6::Zero();
   velocity_dt_ = velocity_stamp_ = last_stamp_ = 0;
@@ -84,10 +126,28 @@ void OdometryTracker::reset() {
 
 void OdometryTracker::setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics,
                                   const std::vector<QuadricMeasurement>* observations,
-                                  IntensityPyramid& intensity) {
+                                  IntensityPyramid& intensity, const cv::Mat* feature_image,
+                                  FeatureFrame* features) {
   icp_.setReference(cloud, intrinsics);
   keyframe_intensity_ = std::move(intensity);
   intensity = IntensityPyramid();
+  // The keyframe being replaced keeps its corners for later frames (when they were made).
+  if (params_.feature_history_keyframes > 0 && !keyframe_features_.empty()) {
+    feature_history_.push_back({std::move(keyframe_features_), T_odom_keyframe_});
+    while (static_cast<int>(feature_history_.size()) > params_.feature_history_keyframes)
+      feature_history_.pop_front();
+  }
+  keyframe_features_ = FeatureFrame();
+  keyframe_image_.release();
+  keyframe_depth_.release();
+  keyframe_intrinsics_ = intrinsics;
+  if (features) {
+    keyframe_features_ = std::move(*features);
+  } else if (feature_image) {
+    // Most keyframes are never asked for their corners (the prior is good): keep what makes them.
+    keyframe_image_ = feature_image->clone();
+    keyframe_depth_ = depthOf(cloud);
+  }
   keyframe_observations_.clear();
   if (observations) {
     for (const QuadricMeasurement& m : *observations) {
@@ -122,6 +182,80 @@ OdometryTracker::Result OdometryTracker::output(TrackingStatus status, bool new_
   return out;
 }
 
+void OdometryTracker::alignFromEarlierKeyframes(
+    const Cloud& cloud, const std::function<FeatureFrame*()>& frame_features,
+    PointToPlaneIcp::Result& best, Result& out) {
+  const FeatureFrame* current = frame_features();
+  if (!current)
+    return;
+  const int n = static_cast<int>(feature_history_.size());
+  for (int back = 1; back <= n; ++back) {
+    const PastKeyframe& past = feature_history_[n - back];
+    FeatureMotionGuess g = feature_guesser_.guess(past.features, *current);
+    if (!g.found)
+      continue;
+    const Eigen::Isometry3d T_past_keyframe = past.T_odom_keyframe.inverse() * T_odom_keyframe_;
+    const Eigen::Isometry3d start = T_past_keyframe.inverse() * g.T_reference_current;
+    if (!withinCameraSpeed(start))
+      continue;
+    // The corners of the earlier keyframe judge an alignment as in alignFromBestStart.
+    const auto agreement = [&](const PointToPlaneIcp::Result& r) {
+      return feature_guesser_.agreeingMatches(g, T_past_keyframe * r.T_reference_current);
+    };
+    const bool strong =
+        g.inliers >= kPlacementInlierFactor * feature_guesser_.params().min_inliers &&
+        g.inliers >= kPlacementInlierShare * g.matches;
+    PointToPlaneIcp::Result from_past = icp_.align(cloud, start);
+    const bool replaces =
+        from_past.status != TrackingStatus::kLost &&
+        (best.status == TrackingStatus::kLost || agreement(from_past) > agreement(best));
+    out.feature_guess = std::move(g);
+    out.feature_keyframes_back = back;
+    if (replaces) {
+      best = std::move(from_past);
+      out.started_from_features = true;
+      out.started_from_last_pose = out.started_from_guess = false;
+      return;
+    }
+    if (best.status != TrackingStatus::kLost || !strong)
+      return;
+    // Nothing of the keyframe overlaps: the corners alone place the frame, which becomes the
+    // keyframe.
+    best = PointToPlaneIcp::Result();
+    best.status = TrackingStatus::kDegenerate;
+    best.T_reference_current = start;
+    best.covariance.setZero();
+    best.covariance.diagonal().head<3>().setConstant(
+        std::pow(params_.feature_pose_sigma_translation, 2));
+    best.covariance.diagonal().tail<3>().setConstant(
+        std::pow(params_.feature_pose_sigma_rotation, 2));
+    best.message = "placed by the corners of a keyframe " + std::to_string(back) + " back";
+    out.placed_by_features = true;
+    out.started_from_features = true;
+    out.started_from_last_pose = out.started_from_guess = false;
+    return;
+  }
+}
+
+bool OdometryTracker::withinCameraSpeed(const Eigen::Isometry3d& T_keyframe_current) const {
+  const Eigen::Isometry3d step = T_odom_camera_.inverse() * T_odom_keyframe_ * T_keyframe_current;
+  const double dt = std::max(step_dt_, 0.0);
+  return step.translation().norm() <=
+             std::max(params_.feature_max_speed * dt, kMinSpeedBoundTranslation) &&
+         pose_math::rotationAngle(step) <=
+             std::max(params_.feature_max_turn_rate * dt, kMinSpeedBoundRotation);
+}
+
+const FeatureFrame* OdometryTracker::keyframeFeatures() {
+  if (keyframe_features_.empty() && !keyframe_image_.empty()) {
+    keyframe_features_ =
+        feature_guesser_.describe(keyframe_image_, keyframe_depth_, keyframe_intrinsics_);
+    keyframe_image_.release();
+    keyframe_depth_.release();
+  }
+  return keyframe_features_.empty() ? nullptr : &keyframe_features_;
+}
+
 bool OdometryTracker::startsElsewhere(const Eigen::Isometry3d& a,
                                       const Eigen::Isometry3d& b) const {
   const Eigen::Isometry3d difference = a.inverse() * b;
@@ -132,7 +266,7 @@ bool OdometryTracker::startsElsewhere(const Eigen::Isometry3d& a,
 PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
     const Cloud& cloud, const Eigen::Isometry3d& T_keyframe_prior,
     const Eigen::Isometry3d& T_keyframe_last, const std::vector<QuadricMeasurement>* observations,
-    Result& out) {
+    const std::function<FeatureFrame*()>& frame_features, Result& out) {
   PointToPlaneIcp::Result best = icp_.align(cloud, T_keyframe_prior);
   if (params_.zero_motion_start && startsElsewhere(T_keyframe_prior, T_keyframe_last)) {
     PointToPlaneIcp::Result from_last = icp_.align(cloud, T_keyframe_last);
@@ -142,21 +276,70 @@ PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
       out.started_from_last_pose = true;
     }
   }
-  if (!params_.quadric_motion_guess || !observations || keyframe_observations_.empty())
-    return best;
   if (best.status == TrackingStatus::kOk &&
       best.inlier_fraction >= params_.guess_skip_inlier_fraction) {
     out.guess.message = "not needed: ICP from the prior is ok with enough inliers";
+    out.feature_guess.message = out.guess.message;
     return best;
   }
-  out.guess = guesser_.guess(keyframe_observations_, *observations, T_keyframe_prior);
-  if (!out.guess.found || !startsElsewhere(T_keyframe_prior, out.guess.T_reference_current))
-    return best;  // the prior already starts where the surfaces say
-  PointToPlaneIcp::Result from_guess = icp_.align(cloud, out.guess.T_reference_current);
-  if (guessAlignmentReplaces(from_guess, best)) {
-    best = std::move(from_guess);
-    out.started_from_guess = true;
-    out.started_from_last_pose = false;
+  // The corners first: where the two images share enough of them they measure all six
+  // directions, while the surfaces of a wall-and-floor view leave three free and may match a
+  // wall to a parallel one (on generated fr1_room at 1.5 Hz such a match moved the camera 60-90
+  // cm where the corners were right within 2 cm).
+  // At full rate a degenerate step is within the intensities' basin: the corners (15-30 ms a
+  // frame) are made when the alignment is lost or the frame comes feature_min_interval after
+  // the last.
+  const bool corners_wanted =
+      params_.feature_motion_guess &&
+      (best.status == TrackingStatus::kLost || step_dt_ >= params_.feature_min_interval);
+  if (corners_wanted) {
+    const FeatureFrame* reference = keyframeFeatures();
+    const FeatureFrame* current = reference ? frame_features() : nullptr;
+    if (current)
+      out.feature_guess = feature_guesser_.guess(*reference, *current);
+    if (out.feature_guess.found && !withinCameraSpeed(out.feature_guess.T_reference_current)) {
+      out.feature_guess.found = false;
+      out.feature_guess.message = "beyond the camera's speed from its last pose";
+    }
+  }
+  if (out.feature_guess.found &&
+      startsElsewhere(best.T_reference_current, out.feature_guess.T_reference_current)) {
+    PointToPlaneIcp::Result from_features =
+        icp_.align(cloud, out.feature_guess.T_reference_current);
+    // The prior and the last pose are unmeasured along any direction the depth leaves free (on a
+    // wall and the floor ICP from the last pose held 15 degrees of a turn back with more inliers
+    // than from the right pose): the corners judge. The alignment the more matched corners agree
+    // with wins, at equal counts the better alignment, at a tie the corners'.
+    const int best_agreement =
+        feature_guesser_.agreeingMatches(out.feature_guess, best.T_reference_current);
+    const int features_agreement =
+        feature_guesser_.agreeingMatches(out.feature_guess, from_features.T_reference_current);
+    if (from_features.status != TrackingStatus::kLost &&
+        (features_agreement > best_agreement ||
+         (features_agreement == best_agreement && !betterAlignment(best, from_features)))) {
+      best = std::move(from_features);
+      out.started_from_features = true;
+      out.started_from_last_pose = false;
+    }
+  }
+  if (corners_wanted && !feature_history_.empty() &&
+      (!out.feature_guess.found || best.status == TrackingStatus::kLost))
+    alignFromEarlierKeyframes(cloud, frame_features, best, out);
+  if (out.feature_guess.found) {
+    out.guess.message = "not needed: the corners' guess was found";
+    return best;
+  }
+  if (params_.quadric_motion_guess && observations && !keyframe_observations_.empty()) {
+    out.guess = guesser_.guess(keyframe_observations_, *observations, T_keyframe_prior);
+    // (When the prior already starts where the surfaces say, there is nothing to try.)
+    if (out.guess.found && startsElsewhere(T_keyframe_prior, out.guess.T_reference_current)) {
+      PointToPlaneIcp::Result from_guess = icp_.align(cloud, out.guess.T_reference_current);
+      if (guessAlignmentReplaces(from_guess, best)) {
+        best = std::move(from_guess);
+        out.started_from_guess = true;
+        out.started_from_last_pose = false;
+      }
+    }
   }
   return best;
 }
@@ -172,14 +355,29 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   const auto usable = [&] { return icp_.usablePoints(cloud) >= params_.icp.min_correspondences; };
   // The frame's intensities, for the photometric refinement and as the next keyframe's.
   // Built when first needed: a degenerate alignment refines with it, a new keyframe keeps it.
-  const bool have_image = params_.photometric_refinement && image && !image->empty() &&
-                          image->cols == intrinsics.width && image->rows == intrinsics.height &&
-                          (image->type() == CV_8UC1 || image->type() == CV_8UC3);
+  const bool have_image = params_.photometric_refinement && usableImage(image, intrinsics);
+  // The frame's corners, made when first needed (the motion guess), kept for a new keyframe.
+  const cv::Mat* feature_image =
+      params_.feature_motion_guess && usableImage(image, intrinsics) ? image : nullptr;
+  FeatureFrame feature_storage;
+  bool features_made = false;
+  const std::function<FeatureFrame*()> frameFeatures = [&]() -> FeatureFrame* {
+    if (!feature_image)
+      return nullptr;
+    if (!features_made)
+      feature_storage = feature_guesser_.describe(*feature_image, depthOf(cloud), intrinsics);
+    features_made = true;
+    return &feature_storage;
+  };
   IntensityPyramid intensity_storage;
   const auto frameIntensity = [&]() -> IntensityPyramid& {
     if (have_image && intensity_storage.empty())
       intensity_storage = IntensityPyramid::fromImage(*image, params_.photometric.levels);
     return intensity_storage;
+  };
+  const auto keepAsKeyframe = [&] {
+    setKeyframe(cloud, intrinsics, observations, frameIntensity(), feature_image,
+                features_made ? &feature_storage : nullptr);
   };
 
   if (!initialized_) {
@@ -191,7 +389,7 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     }
     T_odom_camera_ = Eigen::Isometry3d::Identity();
     covariance_ = Matrix6::Zero();
-    setKeyframe(cloud, intrinsics, observations, frameIntensity());
+    keepAsKeyframe();
     initialized_ = true;
     last_motion_ = Eigen::Isometry3d::Identity();
     velocity_dt_ = 0;
@@ -214,10 +412,21 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
         pose_math::orthonormalized(T_odom_camera_ * pose_math::scaleMotion(last_motion_, k));
   }
   const Eigen::Isometry3d T_keyframe_odom = T_odom_keyframe_.inverse();
+  step_dt_ = dt;
   Result out;
-  PointToPlaneIcp::Result icp = alignFromBestStart(
-      cloud, T_keyframe_odom * prediction, T_keyframe_odom * T_odom_camera_, observations, out);
+  PointToPlaneIcp::Result icp =
+      alignFromBestStart(cloud, T_keyframe_odom * prediction, T_keyframe_odom * T_odom_camera_,
+                         observations, frameFeatures, out);
   bool photometric = false;
+  // With the keyframe's corners' guess found, a degenerate pose must keep at least half of its
+  // agreeing corners: along the directions the depth leaves free the intensities of a far,
+  // repetitively textured wall have minima tens of centimetres apart, the corners one.
+  const bool corners_judge = out.feature_guess.found && out.feature_keyframes_back == 0;
+  const auto cornersAgree = [&](const Eigen::Isometry3d& T_keyframe_current) {
+    return !corners_judge ||
+           kCornerAgreementShare * out.feature_guess.inliers <=
+               feature_guesser_.agreeingMatches(out.feature_guess, T_keyframe_current);
+  };
   if (have_image && icp.status == TrackingStatus::kDegenerate && !keyframe_intensity_.empty()) {
     // Along the directions the depth left free an alignment stays where it started: the
     // constant-velocity prior, the last pose or the surfaces' guess, any of which may be far off
@@ -228,8 +437,11 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     const Eigen::Matrix<double, 6, Eigen::Dynamic> free =
         freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction);
     std::vector<Eigen::Isometry3d> starts = {icp.T_reference_current};
-    for (const Eigen::Isometry3d& other : {Eigen::Isometry3d(T_keyframe_odom * prediction),
-                                           Eigen::Isometry3d(T_keyframe_odom * T_odom_camera_)}) {
+    std::vector<Eigen::Isometry3d> others = {T_keyframe_odom * prediction,
+                                             T_keyframe_odom * T_odom_camera_};
+    if (out.feature_guess.found && out.feature_keyframes_back == 0)
+      others.push_back(out.feature_guess.T_reference_current);
+    for (const Eigen::Isometry3d& other : others) {
       const Eigen::Isometry3d moved =
           priorAlongFreeDirections(icp.T_reference_current, other, free);
       if (std::all_of(starts.begin(), starts.end(),
@@ -242,6 +454,7 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
       candidate.T_reference_current = start;
       PhotometricRefinement::Result refined;
       if (refinePhotometrically(cloud, intrinsics, frameIntensity(), candidate, refined) &&
+          cornersAgree(candidate.T_reference_current) &&
           (!photometric || betterPhotometricMatch(refined, out.photometric))) {
         icp = std::move(candidate);
         out.photometric = std::move(refined);
@@ -253,6 +466,13 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     // Nothing measured the guess along the directions the depth left free (alignment_choice.h).
     icp.T_reference_current = priorAlongFreeDirections(
         icp.T_reference_current, T_keyframe_odom * prediction,
+        freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction));
+  }
+  if (icp.status == TrackingStatus::kDegenerate && !photometric &&
+      !cornersAgree(icp.T_reference_current)) {
+    // The corners measured the directions the depth left free.
+    icp.T_reference_current = priorAlongFreeDirections(
+        icp.T_reference_current, out.feature_guess.T_reference_current,
         freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction));
   }
 
@@ -283,8 +503,11 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     velocity_dt_ = 0;
     covariance_ += Matrix6::Identity() * params_.icp.degenerate_variance;
     if (consecutive_lost_ >= params_.lost_frames_before_new_keyframe && usable()) {
-      setKeyframe(cloud, intrinsics, observations, frameIntensity());
+      keepAsKeyframe();
       new_keyframe = true;
+      // Restarted at the last pose, which the camera has left by an unknown motion: the earlier
+      // keyframes' poses are in another anchor than the poses to come.
+      feature_history_.clear();
     }
   } else {
     consecutive_lost_ = 0;
@@ -327,8 +550,8 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     const Eigen::Isometry3d& from_keyframe = icp.T_reference_current;
     if (from_keyframe.translation().norm() > params_.keyframe_translation ||
         pose_math::rotationAngle(from_keyframe) > params_.keyframe_rotation ||
-        icp.inlier_fraction < params_.keyframe_min_overlap) {
-      setKeyframe(cloud, intrinsics, observations, frameIntensity());
+        icp.inlier_fraction < params_.keyframe_min_overlap || out.placed_by_features) {
+      keepAsKeyframe();
       new_keyframe = true;
     }
   }
@@ -341,6 +564,10 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   result.guess = std::move(out.guess);
   result.started_from_guess = out.started_from_guess;
   result.started_from_last_pose = out.started_from_last_pose;
+  result.feature_guess = std::move(out.feature_guess);
+  result.started_from_features = out.started_from_features;
+  result.feature_keyframes_back = out.feature_keyframes_back;
+  result.placed_by_features = out.placed_by_features;
   result.T_odom_predicted = prediction;
   result.photometric = std::move(out.photometric);
   return result;

@@ -6,10 +6,13 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <deque>
+#include <functional>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "quadric_slam/odometry/feature_motion_guess.h"
 #include "quadric_slam/odometry/photometric_refinement.h"
 #include "quadric_slam/odometry/point_to_plane_icp.h"
 #include "quadric_slam/odometry/quadric_motion_guess.h"
@@ -54,6 +57,36 @@ class OdometryTracker {
     // guess and its extra ICP cost time on every frame.
     double guess_skip_inlier_fraction = 0.9;
     QuadricMotionGuesser::Params guess;
+    // When track() is given the frame's image: guess the motion from the corners the frame shares
+    // with the keyframe too (odometry/feature_motion_guess.h), under the same skip rule, and run
+    // ICP from it when it differs from the best alignment so far; the better alignment is kept,
+    // and a degenerate one is refined by the intensities from the guess as well. A hand-held
+    // camera read at 1.5 Hz turns 10-40 degrees a step, where neither the prior nor the surfaces
+    // of a wall-and-floor view start ICP in its basin.
+    bool feature_motion_guess = false;
+    FeatureMotionGuesser::Params features;
+    // ... made only when every alignment is lost or the frame comes at least this long after the
+    // previous one (s, >= 0; 0: under the skip rule on every frame): between frames 33 ms apart a
+    // degenerate step is within the intensities' basin, and the corners cost 15-30 ms a frame.
+    double feature_min_interval = 0.1;
+    // When the keyframe's corners give no guess (a turn of 40-60 degrees between frames leaves
+    // them few), or every alignment to the keyframe is lost, the corners of up to this many
+    // earlier keyframes (those whose corners were made, newest first) are tried, [0, 1000]; 0:
+    // none. A hand-held camera that swings away and back shares more with a keyframe of a second
+    // ago than with the last one. ICP to the keyframe then starts from that guess; when it finds
+    // no overlap the frame is placed by the corners alone (status degenerate, covariance
+    // feature_pose_sigma_translation / _rotation, m / rad, > 0) and becomes the keyframe, instead
+    // of being lost.
+    int feature_history_keyframes = 0;
+    double feature_pose_sigma_translation = 0.02;
+    double feature_pose_sigma_rotation = 0.02;
+    // A corners' guess that moves the camera from its last pose faster than feature_max_speed
+    // (m/s, > 0) or feature_max_turn_rate (rad/s, > 0) over the time since the last frame (at
+    // least 0.1 m / 0.2 rad) is refused: rooms repeat their surfaces' texture, and the corners of
+    // one wall matched to another agree on a turn of 90 degrees. Placing a frame by the corners
+    // alone also needs twice min_inliers agreeing, half of the matches.
+    double feature_max_speed = 1.5;
+    double feature_max_turn_rate = 2.0;
     // The ICP's normals from the frame's fitted surfaces (odometry/surface_normals.h): track()
     // does not change its cloud, so the caller calls adoptSurfaceNormals() before it (QuadricSlam
     // and the odometry nodelet do).
@@ -127,11 +160,18 @@ class OdometryTracker {
     Eigen::Isometry3d increment = Eigen::Isometry3d::Identity();
     Matrix6 increment_covariance = Matrix6::Zero();
     TrackingStatus status = TrackingStatus::kLost;
-    bool new_keyframe = false;        // this frame became the keyframe
-    int consecutive_lost = 0;         // lost frames in a row, this one included
-    PointToPlaneIcp::Result icp;      // details of the alignment (empty for the first frame)
-    QuadricMotionGuess guess;         // the surfaces' motion guess (found = false when not made)
-    bool started_from_guess = false;  // ICP's result came from the guess, not the prior
+    bool new_keyframe = false;           // this frame became the keyframe
+    int consecutive_lost = 0;            // lost frames in a row, this one included
+    PointToPlaneIcp::Result icp;         // details of the alignment (empty for the first frame)
+    QuadricMotionGuess guess;            // the surfaces' motion guess (found = false when not made)
+    bool started_from_guess = false;     // ICP's result came from the guess, not the prior
+    FeatureMotionGuess feature_guess;    // the corners' motion guess (found = false when not made)
+    bool started_from_features = false;  // ICP's result came from the corners' guess
+    // The corners' guess came from an earlier keyframe (feature_history_keyframes), this many
+    // keyframes back (0: the current keyframe's); placed_by_features: no alignment to the keyframe
+    // held, the pose is the corners' alone.
+    int feature_keyframes_back = 0;
+    bool placed_by_features = false;
     bool started_from_last_pose = false;  // ... from the last pose (zero motion), not the prior
     // The constant-velocity prior's prediction of this frame's pose (the last pose when no
     // confirmed velocity is held; identity for the first frame).
@@ -168,23 +208,41 @@ class OdometryTracker {
   const Params& params() const { return params_; }
 
  private:
-  // intensity: the frame's pyramid (moved into the keyframe's; empty when none).
+  // intensity: the frame's pyramid (moved into the keyframe's; empty when none). features: the
+  // frame's corners when they were made (moved into the keyframe's), else nullptr and, with
+  // feature_image (the frame's image, nullptr when none), the image and depth are kept to make
+  // the keyframe's corners when first needed.
   void setKeyframe(const Cloud& cloud, const CameraIntrinsics& intrinsics,
-                   const std::vector<QuadricMeasurement>* observations,
-                   IntensityPyramid& intensity);
+                   const std::vector<QuadricMeasurement>* observations, IntensityPyramid& intensity,
+                   const cv::Mat* feature_image = nullptr, FeatureFrame* features = nullptr);
+  // The keyframe's corners (made from the kept image on the first call); nullptr when the
+  // keyframe came without an image.
+  const FeatureFrame* keyframeFeatures();
   // Refines a degenerate alignment by the intensities jointly with the depth (Params::
   // photometric_refinement); track() calls it only with both pyramids (the frame's and the
   // keyframe's). Returns whether the pose changed.
   bool refinePhotometrically(const Cloud& cloud, const CameraIntrinsics& intrinsics,
                              const IntensityPyramid& intensity, PointToPlaneIcp::Result& icp,
                              PhotometricRefinement::Result& out) const;
-  // ICP from the prior, from the last pose and from the surfaces' guess when they differ from the
-  // prior; the best of them.
+  // ICP from the prior, from the last pose and from the surfaces' and the corners' guesses when
+  // they differ from the prior; the best of them. frame_features: the frame's corners, made when
+  // first asked for (nullptr when the frame has no image for them).
   PointToPlaneIcp::Result alignFromBestStart(const Cloud& cloud,
                                              const Eigen::Isometry3d& T_keyframe_prior,
                                              const Eigen::Isometry3d& T_keyframe_last,
                                              const std::vector<QuadricMeasurement>* observations,
+                                             const std::function<FeatureFrame*()>& frame_features,
                                              Result& out);
+  // The corners of earlier keyframes (feature_history_keyframes), newest first, when the
+  // keyframe's gave no guess or every alignment is lost: ICP from the first guess found within
+  // the camera's speed, kept when the corners agree with it better than with best; when no
+  // alignment holds and the guess is strong, the frame is placed by the corners alone.
+  void alignFromEarlierKeyframes(const Cloud& cloud,
+                                 const std::function<FeatureFrame*()>& frame_features,
+                                 PointToPlaneIcp::Result& best, Result& out);
+  // The corners' guess T_keyframe_current is within the camera's speed from its last pose over
+  // step_dt_ (feature_max_speed, feature_max_turn_rate).
+  bool withinCameraSpeed(const Eigen::Isometry3d& T_keyframe_current) const;
   // The two starts are further apart than guess_min_translation or guess_min_rotation.
   bool startsElsewhere(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) const;
   Result output(TrackingStatus status, bool new_keyframe) const;
@@ -195,6 +253,18 @@ class OdometryTracker {
   Params params_;
   PointToPlaneIcp icp_;
   QuadricMotionGuesser guesser_;
+  FeatureMotionGuesser feature_guesser_;
+  // The keyframe's corners, or (until they are first needed) its image and depth to make them.
+  FeatureFrame keyframe_features_;
+  cv::Mat keyframe_image_, keyframe_depth_;
+  CameraIntrinsics keyframe_intrinsics_;
+  // Earlier keyframes' corners and poses (feature_history_keyframes), oldest first.
+  struct PastKeyframe {
+    FeatureFrame features;
+    Eigen::Isometry3d T_odom_keyframe;
+  };
+  std::deque<PastKeyframe> feature_history_;
+  double step_dt_ = 0;  // the time since the last frame (s), for withinCameraSpeed()
   PhotometricRefinement photometric_;
   IntensityPyramid keyframe_intensity_;          // empty when the keyframe came without an image
   SurfaceNormalScratch surface_normal_scratch_;  // adoptSurfaceNormals' buffers, kept
