@@ -100,7 +100,8 @@ inline void writeTrackingCsv(const TrackingRun& run, const std::string& name) {
 }
 
 // Tracks every `every`-th frame of `source` (at most max_frames of them) with the stages and
-// parameters of `params` (segmentation only for the motion guess). `truth`: T_world_camera,
+// parameters of `params` (segmentation only for the motion guess; the frames' images, when the
+// source has them, for the corners' guess and the photometric refinement). `truth`: T_world_camera,
 // interpolated at each frame's stamp.
 inline TrackingRun runTracker(FrameSource& source, const Trajectory& truth,
                               const SlamParams& params, int every, int max_frames) {
@@ -122,8 +123,10 @@ inline TrackingRun runTracker(FrameSource& source, const Trajectory& truth,
     const FrameMeasurements measurements =
         toFrameMeasurements(segmenter.segment(cloud), frame.stamp, frame.frame_id);
     tracker.adoptSurfaceNormals(measurements.observations, cloud);  // as QuadricSlam does
+    // The frame's image when the source renders one (the corners' guess and the intensities).
     const OdometryTracker::Result result =
-        tracker.track(cloud, frame.intrinsics, frame.stamp, &measurements.observations);
+        tracker.track(cloud, frame.intrinsics, frame.stamp, &measurements.observations,
+                      frame.rgb.empty() ? nullptr : &frame.rgb);
     TrackedFrame f;
     f.stamp = frame.stamp;
     f.status = result.status;
