@@ -10,10 +10,12 @@
 //             exact stamp, they give the tracker its motion guess for large steps, as in the
 //             offline runner)
 //             rgb/image and rgb/camera_info (sensor_msgs/Image rgb8, bgr8 or mono8 registered to
-//             the depth, through image_transport; only with ~photometric_refinement): each cloud
-//             takes the image nearest its stamp within ~rgb_max_stamp_difference from a buffer of
-//             ~rgb_buffer_size, and a degenerate alignment is refined by its intensities
-//             (odometry/photometric_refinement.h); a cloud whose image has not arrived yet is
+//             the depth, through image_transport; only with ~photometric_refinement or
+//             ~feature_motion_guess): each cloud takes the image nearest its stamp within
+//             ~rgb_max_stamp_difference from a buffer of ~rgb_buffer_size; a degenerate alignment
+//             is refined by its intensities (odometry/photometric_refinement.h) and a large step
+//             guessed from its corners (odometry/feature_motion_guess.h); a cloud whose image has
+//             not arrived yet is
 //             tracked on depth alone (counted on /diagnostics), never held back
 // Publishes   odom (nav_msgs/Odometry: pose of ~camera_frame in ~odom_frame with covariance;
 //             while tracking is lost, the last pose with every pose variance 9999: ros/
@@ -85,7 +87,7 @@ class OdometryNodelet : public nodelet::Nodelet {
       int rgb_buffer_size = 10;
       readParam(reader, "rgb_buffer_size", rgb_buffer_size, log);
       readParam(reader, "rgb_max_stamp_difference", rgb_max_stamp_difference_, log);
-      if (params.photometric_refinement) {
+      if (params.photometric_refinement || params.feature_motion_guess) {
         if (rgb_buffer_size < 1)
           throw std::invalid_argument("rgb_buffer_size must be >= 1");
         colour_images_ = std::make_unique<ColourImageBuffer>(
