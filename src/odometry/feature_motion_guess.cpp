@@ -23,24 +23,21 @@ constexpr double kMinSampleHeight = 0.02;
 // The same seed on every call: the same frames give the same guess.
 constexpr unsigned kRansacSeed = 0x51ca;
 
-struct PointPairs {
-  Eigen::Matrix3Xd reference, current;
-};
-
 Eigen::Isometry3d rigidFit(const Eigen::Matrix3Xd& current, const Eigen::Matrix3Xd& reference) {
   Eigen::Isometry3d T;
   T.matrix() = Eigen::umeyama(current, reference, false);
   return T;
 }
 
-// The pairs (columns) that agree with T_reference_current within the depth-dependent distance.
-std::vector<int> inliersOf(const Eigen::Isometry3d& T, const PointPairs& pairs,
+// The matched pairs (columns of the guess's reference and current points) that agree with
+// T_reference_current within the depth-dependent distance.
+std::vector<int> inliersOf(const Eigen::Isometry3d& T, const FeatureMotionGuess& pairs,
                            const FeatureMotionGuesser::Params& p) {
   std::vector<int> inliers;
-  for (int i = 0; i < static_cast<int>(pairs.reference.cols()); ++i) {
-    const Eigen::Vector3d r = pairs.reference.col(i);
+  for (int i = 0; i < static_cast<int>(pairs.reference_points.cols()); ++i) {
+    const Eigen::Vector3d r = pairs.reference_points.col(i);
     const double gate = p.inlier_distance + p.inlier_distance_per_z2 * r.z() * r.z();
-    if ((T * pairs.current.col(i) - r).squaredNorm() < gate * gate)
+    if ((T * pairs.current_points.col(i) - r).squaredNorm() < gate * gate)
       inliers.push_back(i);
   }
   return inliers;
@@ -154,7 +151,6 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
   }
   std::vector<std::vector<cv::DMatch>> nearest;
   matcher_.knnMatch(current.descriptors, reference.descriptors, nearest, 2);
-  PointPairs pairs;
   std::vector<std::pair<int, int>> kept;  // (current, reference)
   for (const std::vector<cv::DMatch>& m : nearest) {
     if (m.size() == 2 && m[0].distance < params_.match_ratio * m[1].distance)
@@ -165,27 +161,27 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
     out.message = "too few corners matched (" + std::to_string(out.matches) + ")";
     return out;
   }
-  pairs.reference.resize(3, out.matches);
-  pairs.current.resize(3, out.matches);
+  Eigen::Matrix3Xd& reference_points = out.reference_points;
+  Eigen::Matrix3Xd& current_points = out.current_points;
+  reference_points.resize(3, out.matches);
+  current_points.resize(3, out.matches);
   for (int i = 0; i < out.matches; ++i) {
-    pairs.current.col(i) = current.points[kept[i].first];
-    pairs.reference.col(i) = reference.points[kept[i].second];
+    current_points.col(i) = current.points[kept[i].first];
+    reference_points.col(i) = reference.points[kept[i].second];
   }
 
-  out.reference_points = pairs.reference;
-  out.current_points = pairs.current;
   std::mt19937 rng(kRansacSeed);
   std::uniform_int_distribution<int> pick(0, out.matches - 1);
   std::vector<int> best;
   int needed = params_.ransac_iterations;
   for (int iteration = 0; iteration < needed; ++iteration) {
     const int a = pick(rng), b = pick(rng), c = pick(rng);
-    if (!wellShaped(pairs.reference.col(a), pairs.reference.col(b), pairs.reference.col(c)))
+    if (!wellShaped(reference_points.col(a), reference_points.col(b), reference_points.col(c)))
       continue;
     const std::vector<int> sample = {a, b, c};
     const Eigen::Isometry3d T =
-        rigidFit(columns(pairs.current, sample), columns(pairs.reference, sample));
-    std::vector<int> inliers = inliersOf(T, pairs, params_);
+        rigidFit(columns(current_points, sample), columns(reference_points, sample));
+    std::vector<int> inliers = inliersOf(T, out, params_);
     if (inliers.size() <= best.size())
       continue;
     best = std::move(inliers);
@@ -203,11 +199,11 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
     return out;
   }
   // Least squares over the consensus, then once more over the pairs that agree with that.
-  Eigen::Isometry3d T = rigidFit(columns(pairs.current, best), columns(pairs.reference, best));
-  std::vector<int> refined = inliersOf(T, pairs, params_);
+  Eigen::Isometry3d T = rigidFit(columns(current_points, best), columns(reference_points, best));
+  std::vector<int> refined = inliersOf(T, out, params_);
   if (refined.size() >= 3) {
-    T = rigidFit(columns(pairs.current, refined), columns(pairs.reference, refined));
-    best = inliersOf(T, pairs, params_);
+    T = rigidFit(columns(current_points, refined), columns(reference_points, refined));
+    best = inliersOf(T, out, params_);
   }
   out.inliers = static_cast<int>(best.size());
   out.T_reference_current = T;
@@ -217,7 +213,7 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
                   std::to_string(out.matches) + ")";
     return out;
   }
-  if (secondSpread(columns(pairs.reference, best)) < params_.min_spread) {
+  if (secondSpread(columns(reference_points, best)) < params_.min_spread) {
     out.message = "the agreeing corners lie along one line";
     return out;
   }
@@ -227,9 +223,7 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
 
 int FeatureMotionGuesser::agreeingMatches(const FeatureMotionGuess& guess,
                                           const Eigen::Isometry3d& T_reference_current) const {
-  return static_cast<int>(
-      inliersOf(T_reference_current, {guess.reference_points, guess.current_points}, params_)
-          .size());
+  return static_cast<int>(inliersOf(T_reference_current, guess, params_).size());
 }
 
 }  // namespace quadric_slam
