@@ -31,6 +31,10 @@ bool solveQuadratic(double a, double b, double c, double* t0, double* t1) {
   return true;
 }
 
+// Lattice cells between the texture slices of consecutive surface ids: more than any surface
+// spans in texture cells along its local x, so no two surfaces share lattice values.
+constexpr int kTextureSliceSpacing = 10007;
+
 std::uint32_t hash3(int x, int y, int z) {
   std::uint32_t h = static_cast<std::uint32_t>(x) * 73856093u ^
                     static_cast<std::uint32_t>(y) * 19349663u ^
@@ -61,13 +65,13 @@ double valueNoise(const Eigen::Vector3d& p) {
   return result;
 }
 
-// The same on the lattice plane x = 0 (planar surfaces): four lattice values instead of eight.
-double valueNoise2d(double y, double z) {
+// The same on the lattice plane x = slice (planar surfaces): four lattice values instead of eight.
+double valueNoise2d(int slice, double y, double z) {
   const int y0 = static_cast<int>(std::floor(y)), z0 = static_cast<int>(std::floor(z));
   auto smooth = [](double f) { return f * f * (3.0 - 2.0 * f); };
   const double fy = smooth(y - y0), fz = smooth(z - z0);
-  const double a = lattice(0, y0, z0), b = lattice(0, y0 + 1, z0);
-  const double c = lattice(0, y0, z0 + 1), d = lattice(0, y0 + 1, z0 + 1);
+  const double a = lattice(slice, y0, z0), b = lattice(slice, y0 + 1, z0);
+  const double c = lattice(slice, y0, z0 + 1), d = lattice(slice, y0 + 1, z0 + 1);
   return (1 - fz) * ((1 - fy) * a + fy * b) + fz * ((1 - fy) * c + fy * d);
 }
 
@@ -245,12 +249,17 @@ Eigen::Vector3d Surface::albedo(const Eigen::Vector3d& point_local) const {
                         static_cast<long>(std::floor(p.y())) + static_cast<long>(std::floor(p.z()));
     return (parity & 1) ? material_.colour2 : material_.colour;
   }
+  // Each surface reads its own part of the noise lattice (by its id): two walls of one material
+  // do not carry the same pattern, which no real room does and which image corners would match
+  // from one wall to the other.
+  const int slice = kTextureSliceSpacing * id_;
+  p.x() += slice;
   // Smooth value noise plus a fine, uninterpolated grain (one hash) at a quarter of the cell.
   const Eigen::Vector3d fine = 4.0 * p;
   const double grain =
       lattice(static_cast<int>(std::floor(fine.x())), static_cast<int>(std::floor(fine.y())),
               static_cast<int>(std::floor(fine.z())));
-  const double smooth = planar ? valueNoise2d(p.y(), p.z()) : valueNoise(p);
+  const double smooth = planar ? valueNoise2d(slice, p.y(), p.z()) : valueNoise(p);
   const double w = 0.75 * smooth + 0.25 * grain;
   return (1.0 - w) * material_.colour + w * material_.colour2;
 }

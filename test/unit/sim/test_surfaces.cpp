@@ -195,3 +195,37 @@ TEST(Surfaces, OnlyClosedSolidFacesAreCulledFromBehind) {
   EXPECT_TRUE(s[9].closedFace());   // its caps
   EXPECT_TRUE(s[10].closedFace());
 }
+
+// Two walls of one noise-textured material carry different patterns (each surface reads its own
+// part of the noise lattice): a real room's walls do not repeat each other pixel for pixel, and
+// image corners matched from one such wall to the other would agree on a false motion.
+TEST(Surfaces, SurfacesOfOneNoiseMaterialCarryDifferentPatterns) {
+  Scene scene;
+  for (const double x : {2.0, -2.0}) {
+    PrimitiveSpec wall;
+    wall.name = "wall";
+    wall.type = PrimitiveType::kRectangle;
+    wall.T_world_primitive.translation() = Eigen::Vector3d(x, 0, 0);
+    wall.size = Eigen::Vector3d(0, 3, 2);
+    wall.material.texture = Texture::kNoise;
+    wall.material.texture_scale = 0.05;
+    scene.primitives.push_back(wall);
+  }
+  const std::vector<Surface> walls = buildSurfaces(scene);
+  ASSERT_EQ(walls.size(), 2u);
+  int different = 0, samples = 0;
+  double variation = 0;
+  for (double y = -1.4; y < 1.4; y += 0.07)
+    for (double z = -0.9; z < 0.9; z += 0.07) {
+      const Eigen::Vector3d point(0, y, z);
+      const Eigen::Vector3d a = walls[0].albedo(point), b = walls[1].albedo(point);
+      different += (a - b).norm() > 0.05;
+      variation += (a - walls[0].albedo(Eigen::Vector3d(0, y + 0.035, z))).norm();
+      ++samples;
+    }
+  EXPECT_GT(variation / samples, 0.02) << "the texture does not vary over the wall";
+  EXPECT_GT(different, samples / 2) << different << " of " << samples << " points differ";
+  // The same surface gives the same pattern every time it is built (sequences are reproducible).
+  EXPECT_EQ(buildSurfaces(scene)[1].albedo(Eigen::Vector3d(0, 0.3, 0.2)),
+            walls[1].albedo(Eigen::Vector3d(0, 0.3, 0.2)));
+}
