@@ -20,6 +20,10 @@ constexpr double kRansacConfidence = 0.99;
 // triangle's smallest height, m): a sliver fixes no rotation about its long side.
 constexpr double kMinSampleSide = 0.05;
 constexpr double kMinSampleHeight = 0.02;
+// ORB's scale step between pyramid levels.
+constexpr double kPyramidScale = 1.2;
+// Refinements on the reprojections (each over the pairs agreeing with the last pose).
+constexpr int kRefinementRounds = 2;
 // The same seed on every call: the same frames give the same guess.
 constexpr unsigned kRansacSeed = 0x51ca;
 
@@ -27,20 +31,6 @@ Eigen::Isometry3d rigidFit(const Eigen::Matrix3Xd& current, const Eigen::Matrix3
   Eigen::Isometry3d T;
   T.matrix() = Eigen::umeyama(current, reference, false);
   return T;
-}
-
-// The matched pairs (columns of the guess's reference and current points) that agree with
-// T_reference_current within the depth-dependent distance.
-std::vector<int> inliersOf(const Eigen::Isometry3d& T, const FeatureMotionGuess& pairs,
-                           const FeatureMotionGuesser::Params& p) {
-  std::vector<int> inliers;
-  for (int i = 0; i < static_cast<int>(pairs.reference_points.cols()); ++i) {
-    const Eigen::Vector3d r = pairs.reference_points.col(i);
-    const double gate = p.inlier_distance + p.inlier_distance_per_z2 * r.z() * r.z();
-    if ((T * pairs.current_points.col(i) - r).squaredNorm() < gate * gate)
-      inliers.push_back(i);
-  }
-  return inliers;
 }
 
 bool wellShaped(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
@@ -79,6 +69,8 @@ void FeatureMotionGuesser::Params::validate() const {
   check(min_depth > 0 && std::isfinite(min_depth), "min_depth", "(0, inf) m", min_depth);
   check(max_depth > min_depth && std::isfinite(max_depth), "max_depth", "(min_depth, inf) m",
         max_depth);
+  check(inlier_pixels > 0 && std::isfinite(inlier_pixels), "inlier_pixels", "(0, inf) px",
+        inlier_pixels);
   check(inlier_distance > 0 && std::isfinite(inlier_distance), "inlier_distance", "(0, inf) m",
         inlier_distance);
   check(inlier_distance_per_z2 >= 0 && std::isfinite(inlier_distance_per_z2),
@@ -95,8 +87,9 @@ FeatureMotionGuesser::FeatureMotionGuesser() : FeatureMotionGuesser(Params()) {}
 
 FeatureMotionGuesser::FeatureMotionGuesser(const Params& params)
     : params_((params.validate(), params)),
-      orb_(cv::ORB::create(params.max_features, 1.2f, params.pyramid_levels, 31, 0, 2,
-                           cv::ORB::HARRIS_SCORE, 31, params.fast_threshold)) {}
+      orb_(cv::ORB::create(params.max_features, static_cast<float>(kPyramidScale),
+                           params.pyramid_levels, 31, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+                           params.fast_threshold)) {}
 
 FeatureFrame FeatureMotionGuesser::describe(const cv::Mat& image, const cv::Mat& depth,
                                             const CameraIntrinsics& intrinsics) {
@@ -134,8 +127,11 @@ FeatureFrame FeatureMotionGuesser::describe(const cv::Mat& image, const cv::Mat&
     // The corner's own (sub-pixel) ray at its grid cell's depth.
     frame.points.emplace_back((pixel.x - intrinsics.cx) * z / intrinsics.fx,
                               (pixel.y - intrinsics.cy) * z / intrinsics.fy, z);
+    frame.pixels.emplace_back(pixel.x, pixel.y);
+    frame.pixel_scales.push_back(std::pow(kPyramidScale, keypoints[i].octave));
     rows.push_back(static_cast<int>(i));
   }
+  frame.intrinsics = intrinsics;
   frame.descriptors.create(static_cast<int>(rows.size()), descriptors.cols, descriptors.type());
   for (size_t i = 0; i < rows.size(); ++i)
     descriptors.row(rows[i]).copyTo(frame.descriptors.row(static_cast<int>(i)));
@@ -161,14 +157,26 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
     out.message = "too few corners matched (" + std::to_string(out.matches) + ")";
     return out;
   }
-  Eigen::Matrix3Xd& reference_points = out.reference_points;
-  Eigen::Matrix3Xd& current_points = out.current_points;
-  reference_points.resize(3, out.matches);
-  current_points.resize(3, out.matches);
-  for (int i = 0; i < out.matches; ++i) {
-    current_points.col(i) = current.points[kept[i].first];
-    reference_points.col(i) = reference.points[kept[i].second];
-  }
+  const auto gather = [&](const FeatureFrame& frame, bool is_current, MatchedCorners& side) {
+    side.points.resize(3, out.matches);
+    side.pixels.resize(2, out.matches);
+    side.pixel_scales.resize(out.matches);
+    side.intrinsics = frame.intrinsics;
+    for (int i = 0; i < out.matches; ++i) {
+      const int index = is_current ? kept[i].first : kept[i].second;
+      side.points.col(i) = frame.points[index];
+      side.pixels.col(i) = frame.pixels[index];
+      side.pixel_scales(i) = frame.pixel_scales[index];
+    }
+  };
+  gather(reference, false, out.reference);
+  gather(current, true, out.current);
+  const Eigen::Matrix3Xd& reference_points = out.reference.points;
+  const Eigen::Matrix3Xd& current_points = out.current.points;
+  const CornerPairGates gates = this->gates();
+  const auto agreeing = [&](const Eigen::Isometry3d& T) {
+    return cornerPairsAgreeing(out.reference, out.current, T, gates);
+  };
 
   std::mt19937 rng(kRansacSeed);
   std::uniform_int_distribution<int> pick(0, out.matches - 1);
@@ -181,7 +189,7 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
     const std::vector<int> sample = {a, b, c};
     const Eigen::Isometry3d T =
         rigidFit(columns(current_points, sample), columns(reference_points, sample));
-    std::vector<int> inliers = inliersOf(T, out, params_);
+    std::vector<int> inliers = agreeing(T);
     if (inliers.size() <= best.size())
       continue;
     best = std::move(inliers);
@@ -198,12 +206,19 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
                   std::to_string(best.size()) + " of " + std::to_string(out.matches) + ")";
     return out;
   }
-  // Least squares over the consensus, then once more over the pairs that agree with that.
+  // Least squares in 3D over the consensus, then on the reprojections and depths over the pairs
+  // that agree, twice (the second time over the pairs agreeing with the first refinement); a
+  // refinement is kept when at least as many pairs agree with it.
   Eigen::Isometry3d T = rigidFit(columns(current_points, best), columns(reference_points, best));
-  std::vector<int> refined = inliersOf(T, out, params_);
-  if (refined.size() >= 3) {
-    T = rigidFit(columns(current_points, refined), columns(reference_points, refined));
-    best = inliersOf(T, out, params_);
+  best = agreeing(T);
+  for (int round = 0; round < kRefinementRounds && best.size() >= 3; ++round) {
+    const Eigen::Isometry3d refined =
+        refineCornerPairPose(out.reference, out.current, best, T, gates);
+    std::vector<int> refined_agreeing = agreeing(refined);
+    if (refined_agreeing.size() < best.size())
+      break;
+    T = refined;
+    best = std::move(refined_agreeing);
   }
   out.inliers = static_cast<int>(best.size());
   out.T_reference_current = T;
@@ -221,9 +236,32 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
   return out;
 }
 
+int FeatureMotionGuesser::screenMatches(const FeatureFrame& reference, const FeatureFrame& current,
+                                        int stride) const {
+  if (reference.descriptors.rows < 2 || current.descriptors.empty() || stride < 1)
+    return 0;
+  cv::Mat sampled;
+  for (int row = 0; row < current.descriptors.rows; row += stride)
+    sampled.push_back(current.descriptors.row(row));
+  std::vector<std::vector<cv::DMatch>> nearest;
+  matcher_.knnMatch(sampled, reference.descriptors, nearest, 2);
+  return static_cast<int>(std::count_if(nearest.begin(), nearest.end(), [&](const auto& m) {
+    return m.size() == 2 && m[0].distance < params_.match_ratio * m[1].distance;
+  }));
+}
+
 int FeatureMotionGuesser::agreeingMatches(const FeatureMotionGuess& guess,
                                           const Eigen::Isometry3d& T_reference_current) const {
-  return static_cast<int>(inliersOf(T_reference_current, guess, params_).size());
+  return static_cast<int>(
+      cornerPairsAgreeing(guess.reference, guess.current, T_reference_current, gates()).size());
+}
+
+CornerPairGates FeatureMotionGuesser::gates() const {
+  CornerPairGates gates;
+  gates.pixels = params_.inlier_pixels;
+  gates.depth = params_.inlier_distance;
+  gates.depth_per_z2 = params_.inlier_distance_per_z2;
+  return gates;
 }
 
 }  // namespace quadric_slam

@@ -24,6 +24,12 @@ constexpr double kMinSpeedBoundRotation = 0.2;
 // matches, agreeing.
 constexpr int kPlacementInlierFactor = 2;
 constexpr double kPlacementInlierShare = 0.5;
+// Earlier keyframes are screened with every kHistoryScreenStride-th corner of the frame; those
+// with at least kHistoryScreenMinMatches matches, at most kHistoryKeyframesGuessed of them (the
+// most matched), are asked for a full guess.
+constexpr int kHistoryScreenStride = 8;
+constexpr int kHistoryScreenMinMatches = 3;
+constexpr int kHistoryKeyframesGuessed = 3;
 // A degenerate pose must keep this share of the keyframe's corners' agreeing matches.
 constexpr double kCornerAgreementShare = 0.5;
 
@@ -188,53 +194,109 @@ void OdometryTracker::alignFromEarlierKeyframes(
   const FeatureFrame* current = frame_features();
   if (!current)
     return;
+  // Not the newest earlier keyframe but the one with the strongest consensus: a camera swinging
+  // back sees again what it saw several keyframes ago, and a few corners matched over a sliver of
+  // overlap can agree on a wrong motion (on generated fr1_room at 1.5 Hz, after a 58-degree turn,
+  // the keyframe before agreed 53 of 109 matches on a pose 39 degrees off; three back agreed 777
+  // of 815 on the right one). A full guess costs 15-30 ms: a sample of the frame's corners first
+  // tells which earlier keyframes share the most with it, and only those are asked.
   const int n = static_cast<int>(feature_history_.size());
+  std::vector<std::pair<int, int>> shared;  // (screened matches, keyframes back)
   for (int back = 1; back <= n; ++back) {
+    const int matches = feature_guesser_.screenMatches(feature_history_[n - back].features,
+                                                       *current, kHistoryScreenStride);
+    if (matches >= kHistoryScreenMinMatches)
+      shared.emplace_back(matches, back);
+  }
+  std::stable_sort(shared.begin(), shared.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  if (static_cast<int>(shared.size()) > kHistoryKeyframesGuessed)
+    shared.resize(kHistoryKeyframesGuessed);
+  FeatureMotionGuess g;
+  int back_chosen = 0;
+  Eigen::Isometry3d T_past_keyframe = Eigen::Isometry3d::Identity(), start = T_past_keyframe;
+  for (const auto& screened : shared) {
+    const int back = screened.second;
     const PastKeyframe& past = feature_history_[n - back];
-    FeatureMotionGuess g = feature_guesser_.guess(past.features, *current);
-    if (!g.found)
+    FeatureMotionGuess candidate = feature_guesser_.guess(past.features, *current);
+    if (!candidate.found || candidate.inliers <= g.inliers)
       continue;
-    const Eigen::Isometry3d T_past_keyframe = past.T_odom_keyframe.inverse() * T_odom_keyframe_;
-    const Eigen::Isometry3d start = T_past_keyframe.inverse() * g.T_reference_current;
-    if (!withinCameraSpeed(start))
+    const Eigen::Isometry3d T_past = past.T_odom_keyframe.inverse() * T_odom_keyframe_;
+    const Eigen::Isometry3d candidate_start = T_past.inverse() * candidate.T_reference_current;
+    if (!withinCameraSpeed(candidate_start))
       continue;
-    // The corners of the earlier keyframe judge an alignment as in alignFromBestStart.
-    const auto agreement = [&](const PointToPlaneIcp::Result& r) {
-      return feature_guesser_.agreeingMatches(g, T_past_keyframe * r.T_reference_current);
-    };
-    const bool strong =
-        g.inliers >= kPlacementInlierFactor * feature_guesser_.params().min_inliers &&
-        g.inliers >= kPlacementInlierShare * g.matches;
-    PointToPlaneIcp::Result from_past = icp_.align(cloud, start);
-    const bool replaces =
-        from_past.status != TrackingStatus::kLost &&
-        (best.status == TrackingStatus::kLost || agreement(from_past) > agreement(best));
-    out.feature_guess = std::move(g);
-    out.feature_keyframes_back = back;
-    if (replaces) {
-      best = std::move(from_past);
-      out.started_from_features = true;
-      out.started_from_last_pose = out.started_from_guess = false;
-      return;
+    g = std::move(candidate);
+    back_chosen = back;
+    T_past_keyframe = T_past;
+    start = candidate_start;
+  }
+  // The keyframe's own guess, when found, stands unless an earlier keyframe's is stronger.
+  if (!g.found || (out.feature_guess.found && g.inliers <= out.feature_guess.inliers))
+    return;
+  // The corners of the earlier keyframe judge an alignment as in alignFromBestStart.
+  const auto agreement = [&](const PointToPlaneIcp::Result& r) {
+    return feature_guesser_.agreeingMatches(g, T_past_keyframe * r.T_reference_current);
+  };
+  PointToPlaneIcp::Result from_past = icp_.align(cloud, start);
+  const bool strong = strongGuess(g);
+  const int best_agreement = best.status == TrackingStatus::kLost ? 0 : agreement(best);
+  const int past_agreement = from_past.status == TrackingStatus::kLost ? 0 : agreement(from_past);
+  // Little of the keyframe may overlap, so ICP against it may not hold from the corners' start:
+  // a strong guess's alignment must keep half of its agreeing corners. When none does, the
+  // corners alone place the frame, which becomes the keyframe.
+  const double kept = strong ? kCornerAgreementShare * g.inliers : 0.0;
+  const bool replaces = from_past.status != TrackingStatus::kLost &&
+                        past_agreement > best_agreement && past_agreement >= kept;
+  const bool placed = !replaces && strong && best_agreement < kept;
+  if (!replaces && !placed) {
+    if (!out.feature_guess.found) {  // reported, though it changed nothing
+      out.feature_guess = std::move(g);
+      out.feature_keyframes_back = back_chosen;
     }
-    if (best.status != TrackingStatus::kLost || !strong)
-      return;
-    // Nothing of the keyframe overlaps: the corners alone place the frame, which becomes the
-    // keyframe.
-    best = PointToPlaneIcp::Result();
-    best.status = TrackingStatus::kDegenerate;
-    best.T_reference_current = start;
-    best.covariance.setZero();
-    best.covariance.diagonal().head<3>().setConstant(
-        std::pow(params_.feature_pose_sigma_translation, 2));
-    best.covariance.diagonal().tail<3>().setConstant(
-        std::pow(params_.feature_pose_sigma_rotation, 2));
-    best.message = "placed by the corners of a keyframe " + std::to_string(back) + " back";
-    out.placed_by_features = true;
+    return;
+  }
+  out.feature_guess = std::move(g);
+  out.feature_keyframes_back = back_chosen;
+  if (replaces) {
+    best = std::move(from_past);
     out.started_from_features = true;
     out.started_from_last_pose = out.started_from_guess = false;
     return;
   }
+  best = placedByCorners(start, back_chosen);
+  out.placed_by_features = true;
+  out.started_from_features = true;
+  out.started_from_last_pose = out.started_from_guess = false;
+}
+
+PointToPlaneIcp::Result OdometryTracker::placedByCorners(
+    const Eigen::Isometry3d& T_keyframe_current, int keyframes_back) const {
+  PointToPlaneIcp::Result placed;
+  placed.status = TrackingStatus::kDegenerate;
+  placed.T_reference_current = T_keyframe_current;
+  placed.covariance.setZero();
+  placed.covariance.diagonal().head<3>().setConstant(
+      std::pow(params_.feature_pose_sigma_translation, 2));
+  placed.covariance.diagonal().tail<3>().setConstant(
+      std::pow(params_.feature_pose_sigma_rotation, 2));
+  placed.message = "placed by the corners of " +
+                   (keyframes_back == 0 ? std::string("the keyframe")
+                                        : "a keyframe " + std::to_string(keyframes_back) + " back");
+  return placed;
+}
+
+Eigen::Isometry3d OdometryTracker::cornersReferenceFromKeyframe(const Result& out) const {
+  const int n = static_cast<int>(feature_history_.size());
+  if (!out.feature_guess.found || out.feature_keyframes_back <= 0 || out.feature_keyframes_back > n)
+    return Eigen::Isometry3d::Identity();
+  return feature_history_[n - out.feature_keyframes_back].T_odom_keyframe.inverse() *
+         T_odom_keyframe_;
+}
+
+bool OdometryTracker::strongGuess(const FeatureMotionGuess& guess) const {
+  return guess.found &&
+         guess.inliers >= kPlacementInlierFactor * feature_guesser_.params().min_inliers &&
+         guess.inliers >= kPlacementInlierShare * guess.matches;
 }
 
 bool OdometryTracker::withinCameraSpeed(const Eigen::Isometry3d& T_keyframe_current) const {
@@ -323,7 +385,8 @@ PointToPlaneIcp::Result OdometryTracker::alignFromBestStart(
     }
   }
   if (corners_wanted && !feature_history_.empty() &&
-      (!out.feature_guess.found || best.status == TrackingStatus::kLost))
+      (!out.feature_guess.found || best.status == TrackingStatus::kLost ||
+       !strongGuess(out.feature_guess)))
     alignFromEarlierKeyframes(cloud, frame_features, best, out);
   if (out.feature_guess.found) {
     out.guess.message = "not needed: the corners' guess was found";
@@ -421,11 +484,13 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   // With the keyframe's corners' guess found, a degenerate pose must keep at least half of its
   // agreeing corners: along the directions the depth leaves free the intensities of a far,
   // repetitively textured wall have minima tens of centimetres apart, the corners one.
-  const bool corners_judge = out.feature_guess.found && out.feature_keyframes_back == 0;
+  // (An earlier keyframe's corners judge the same way, the pose carried into that keyframe.)
+  const Eigen::Isometry3d T_corners_keyframe = cornersReferenceFromKeyframe(out);
   const auto cornersAgree = [&](const Eigen::Isometry3d& T_keyframe_current) {
-    return !corners_judge ||
+    return !out.feature_guess.found ||
            kCornerAgreementShare * out.feature_guess.inliers <=
-               feature_guesser_.agreeingMatches(out.feature_guess, T_keyframe_current);
+               feature_guesser_.agreeingMatches(out.feature_guess,
+                                                T_corners_keyframe * T_keyframe_current);
   };
   if (have_image && icp.status == TrackingStatus::kDegenerate && !keyframe_intensity_.empty()) {
     // Along the directions the depth left free an alignment stays where it started: the
@@ -439,8 +504,8 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     std::vector<Eigen::Isometry3d> starts = {icp.T_reference_current};
     std::vector<Eigen::Isometry3d> others = {T_keyframe_odom * prediction,
                                              T_keyframe_odom * T_odom_camera_};
-    if (out.feature_guess.found && out.feature_keyframes_back == 0)
-      others.push_back(out.feature_guess.T_reference_current);
+    if (out.feature_guess.found)
+      others.push_back(T_corners_keyframe.inverse() * out.feature_guess.T_reference_current);
     for (const Eigen::Isometry3d& other : others) {
       const Eigen::Isometry3d moved =
           priorAlongFreeDirections(icp.T_reference_current, other, free);
@@ -471,9 +536,20 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   if (icp.status == TrackingStatus::kDegenerate && !photometric &&
       !cornersAgree(icp.T_reference_current)) {
     // The corners measured the directions the depth left free.
-    icp.T_reference_current = priorAlongFreeDirections(
-        icp.T_reference_current, out.feature_guess.T_reference_current,
+    const Eigen::Isometry3d T_keyframe_corners =
+        T_corners_keyframe.inverse() * out.feature_guess.T_reference_current;
+    const Eigen::Isometry3d moved = priorAlongFreeDirections(
+        icp.T_reference_current, T_keyframe_corners,
         freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction));
+    if (cornersAgree(moved) || !strongGuess(out.feature_guess)) {
+      icp.T_reference_current = moved;
+    } else {
+      // Where the depth constrains the alignment it still disagrees with a strong guess: ICP
+      // matched a surface to the wrong one (little of the keyframe overlaps, or a wall to a
+      // parallel one), and the corners alone place the frame.
+      icp = placedByCorners(T_keyframe_corners, out.feature_keyframes_back);
+      out.placed_by_features = true;
+    }
   }
 
   const Eigen::Isometry3d previous = T_odom_camera_;

@@ -76,6 +76,7 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "feature_match_ratio", features.match_ratio, log);
   readParam(reader, "feature_min_depth", features.min_depth, log);
   readParam(reader, "feature_max_depth", features.max_depth, log);
+  readParam(reader, "feature_inlier_pixels", features.inlier_pixels, log);
   readParam(reader, "feature_inlier_distance", features.inlier_distance, log);
   readParam(reader, "feature_inlier_distance_per_z2", features.inlier_distance_per_z2, log);
   readParam(reader, "feature_ransac_iterations", features.ransac_iterations, log);

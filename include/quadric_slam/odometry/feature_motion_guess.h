@@ -6,9 +6,13 @@
 // ORB corners (OpenCV) on each image, matched by descriptor: the nearest neighbour, kept when it is
 // clearly nearer than the second (Lowe's ratio test). Each match is lifted to a pair of 3D points
 // by the depth at its pixels; the rigid motion most pairs agree with is found by RANSAC over
-// minimal sets of three (Eigen::umeyama), with a distance that grows with the depth's noise (as
-// z^2 for a disparity sensor), and refitted by least squares over its inliers. Nothing here uses
-// a prior: the guess holds for any step the two images still share corners over.
+// minimal sets of three (Eigen::umeyama). A pair agrees when each corner, moved into the other
+// camera, reprojects within a few pixels of its match and its depth along the ray is within the
+// depth's noise (growing as z^2 for a disparity sensor; odometry/corner_pair_geometry.h): a 3D
+// distance wide enough for that noise let motions 10-20 cm apart agree with the same far corners.
+// The consensus is refitted by least squares in 3D, then refined on the reprojection errors and
+// depths (Ceres). Nothing here uses a prior: the guess holds for any step the two images still
+// share corners over.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,15 +23,19 @@
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 
+#include "quadric_slam/odometry/corner_pair_geometry.h"
 #include "quadric_slam/types/camera_intrinsics.h"
 
 namespace quadric_slam {
 
-// One frame's corners that have a depth: their 3D points (camera frame, m) and ORB descriptors
-// (one row each, in the same order).
+// One frame's corners that have a depth: their 3D points (camera frame, m), sub-pixel positions,
+// pyramid-level scales and ORB descriptors (one row each, in the same order), and the camera.
 struct FeatureFrame {
   std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<double> pixel_scales;
   cv::Mat descriptors;
+  CameraIntrinsics intrinsics;
   bool empty() const { return points.empty(); }
 };
 
@@ -38,8 +46,8 @@ struct FeatureMotionGuess {
   int matches = 0;      // descriptor matches that passed the ratio test
   int inliers = 0;      // ... and agree with the motion
   std::string message;  // why nothing was found (empty when found)
-  // The matched corners' points (columns, camera frames), to judge other poses by them.
-  Eigen::Matrix3Xd reference_points, current_points;
+  // The matched corners (columns in match order), to judge other poses by them.
+  MatchedCorners reference, current;
 };
 
 class FeatureMotionGuesser {
@@ -59,10 +67,11 @@ class FeatureMotionGuesser {
     // Corners whose depth lies outside [min_depth, max_depth] (m) are not used. 0 < min < max
     double min_depth = 0.3;
     double max_depth = 6.0;
-    // A pair agrees with a motion when the current point, moved by it, lies within
-    // inlier_distance + inlier_distance_per_z2 z^2 of the reference point (m; z the reference
-    // point's depth): the sensor's depth noise grows with z^2, a corner's pixel error with z.
-    // > 0 and >= 0
+    // A pair agrees with a motion when each corner, moved into the other camera, reprojects
+    // within inlier_pixels (at the corner's pyramid level) of its match, and its depth is within
+    // inlier_distance + inlier_distance_per_z2 z^2 (m; z the match's depth) of the match's: the
+    // sensor's depth noise grows with z^2. > 0, > 0 and >= 0
+    double inlier_pixels = 3.0;
     double inlier_distance = 0.02;
     double inlier_distance_per_z2 = 0.01;
     // RANSAC's minimal sets at most, [1, 100000]; fewer when the inlier share found so far makes
@@ -89,6 +98,10 @@ class FeatureMotionGuesser {
   // The motion of the current frame in the reference frame's camera.
   FeatureMotionGuess guess(const FeatureFrame& reference, const FeatureFrame& current) const;
 
+  // How many of every stride-th of the current frame's corners pass the ratio test against the
+  // reference's: a cheap measure of how much two views share, to choose which to guess between.
+  int screenMatches(const FeatureFrame& reference, const FeatureFrame& current, int stride) const;
+
   // How many of the guess's matched corners agree with T_reference_current (the inlier distance
   // above): a pose from another start judged by the corners.
   int agreeingMatches(const FeatureMotionGuess& guess,
@@ -97,6 +110,8 @@ class FeatureMotionGuesser {
   const Params& params() const { return params_; }
 
  private:
+  CornerPairGates gates() const;
+
   Params params_;
   cv::Ptr<cv::ORB> orb_;
   cv::BFMatcher matcher_{cv::NORM_HAMMING};

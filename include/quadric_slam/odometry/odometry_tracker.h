@@ -233,13 +233,24 @@ class OdometryTracker {
                                              const std::vector<QuadricMeasurement>* observations,
                                              const std::function<FeatureFrame*()>& frame_features,
                                              Result& out);
-  // The corners of earlier keyframes (feature_history_keyframes), newest first, when the
-  // keyframe's gave no guess or every alignment is lost: ICP from the first guess found within
-  // the camera's speed, kept when the corners agree with it better than with best; when no
-  // alignment holds and the guess is strong, the frame is placed by the corners alone.
+  // The corners of earlier keyframes (feature_history_keyframes) when the keyframe's gave no
+  // guess or a weak one, or every alignment is lost: ICP from the guess with the most agreeing
+  // matches within the camera's speed (when it has more than the keyframe's), kept when its
+  // corners agree with it better than with best; when no alignment holds and the guess is
+  // strong, the frame is placed by the corners alone.
   void alignFromEarlierKeyframes(const Cloud& cloud,
                                  const std::function<FeatureFrame*()>& frame_features,
                                  PointToPlaneIcp::Result& best, Result& out);
+  // A degenerate alignment at the corners' pose, with the feature_pose_sigma_* covariance.
+  PointToPlaneIcp::Result placedByCorners(const Eigen::Isometry3d& T_keyframe_current,
+                                          int keyframes_back) const;
+  // T_reference_keyframe for the keyframe whose corners made out.feature_guess (identity for the
+  // keyframe's own; an earlier keyframe's, feature_keyframes_back, in the odometry chain).
+  Eigen::Isometry3d cornersReferenceFromKeyframe(const Result& out) const;
+  // Enough of the guess's matches agree (kPlacementInlierFactor x min_inliers, and
+  // kPlacementInlierShare of the matches) to place a frame by it alone, or to stand without
+  // asking the earlier keyframes.
+  bool strongGuess(const FeatureMotionGuess& guess) const;
   // The corners' guess T_keyframe_current is within the camera's speed from its last pose over
   // step_dt_ (feature_max_speed, feature_max_turn_rate).
   bool withinCameraSpeed(const Eigen::Isometry3d& T_keyframe_current) const;

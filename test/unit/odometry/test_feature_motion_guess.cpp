@@ -181,6 +181,9 @@ TEST(FeatureMotionGuess, BadParamsAreNamed) {
   p = FeatureMotionGuesser::Params();
   p.min_inliers = 2;
   EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = FeatureMotionGuesser::Params();
+  p.inlier_pixels = 0;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
 }
 
 // The tracker on a real frame and its view from 25 cm and 20 degrees away, 0.67 s later (a
@@ -262,6 +265,53 @@ TEST(FeatureMotionGuess, AnEarlierKeyframesCornersPlaceASwingBack) {
                                 "not show the earlier keyframes'";
     }
   }
+}
+
+// The camera turns 15 and then 30 degrees one way and comes back to 15 degrees the other side of
+// where it started, 0.67 s apart: the last view shares little with the keyframe (45 degrees), some
+// with the keyframe before (30 degrees) and most with the first (15). The earlier keyframe whose
+// corners agree the most places it, not the newest that gives a guess.
+TEST(FeatureMotionGuess, TheEarlierKeyframeSharingTheMostPlacesTheFrame) {
+  const CameraIntrinsics k = test::fr1Intrinsics();
+  const ColourDepthFrame first = shippedFrame(test::kFr1XyzDepthA, test::kFr1XyzRgbA);
+  const std::vector<Eigen::Isometry3d> path = {
+      Eigen::Isometry3d::Identity(), motion({0.12, 0.0, 0.02}, {0, 1, 0}, 15),
+      motion({0.22, 0.0, 0.05}, {0, 1, 0}, 30), motion({-0.12, 0.01, 0.0}, {0, 1, 0}, -15)};
+  std::vector<ColourDepthFrame> views = {first};
+  for (size_t i = 1; i < path.size(); ++i)
+    views.push_back(movedView(first, k, path[i]));
+  // The newest earlier keyframe does give a guess, with fewer agreeing corners than the first.
+  FeatureMotionGuesser guesser;
+  const auto describe = [&](const ColourDepthFrame& f) {
+    return guesser.describe(f.rgb, zeroForNaN(f.depth_m), k);
+  };
+  const FeatureFrame last = describe(views[3]);
+  const FeatureMotionGuess from_newest = guesser.guess(describe(views[1]), last);
+  const FeatureMotionGuess from_first = guesser.guess(describe(views[0]), last);
+  ASSERT_TRUE(from_newest.found) << "the test would not tell the newest from the strongest";
+  ASSERT_TRUE(from_first.found);
+  ASSERT_LT(from_newest.inliers, from_first.inliers);
+
+  const NormalEstimator normals{NormalEstimator::Params()};
+  OdometryTracker::Params params;
+  params.feature_motion_guess = true;
+  params.feature_history_keyframes = 10;
+  params.photometric_refinement = true;
+  OdometryTracker tracker(params);
+  OdometryTracker::Result r;
+  for (size_t i = 0; i < path.size(); ++i) {
+    const OdometryTracker::Cloud cloud =
+        normals.compute(backProject(depthViewOf(views[i].depth_m), k, BackProjectionParams()));
+    r = tracker.track(cloud, k, 0.67 * static_cast<double>(i), nullptr, &views[i].rgb);
+    if (i < 3) {
+      ASSERT_TRUE(r.new_keyframe) << "frame " << i;
+      ASSERT_LT(translationError(r.T_odom_camera, path[i]), 0.02) << "frame " << i;
+    }
+  }
+  EXPECT_EQ(r.feature_keyframes_back, 2) << r.feature_guess.message;
+  EXPECT_NE(r.status, TrackingStatus::kLost) << r.icp.message;
+  EXPECT_LT(translationError(r.T_odom_camera, path[3]), 0.02);
+  EXPECT_LT(rotationErrorDeg(r.T_odom_camera, path[3]), 1.0);
 }
 
 }  // namespace
