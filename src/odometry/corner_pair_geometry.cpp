@@ -13,6 +13,8 @@ constexpr double kMinProjectedDepth = 0.05;
 // The depth gate spans this many standard deviations of the depth noise.
 constexpr double kDepthGateSigmas = 3.0;
 constexpr int kRefinementIterations = 20;
+// Central-difference step of the information's Jacobian (m, rad).
+constexpr double kInformationStep = 1e-6;
 
 double depthGate(double z, const CornerPairGates& gates) {
   return gates.depth + gates.depth_per_z2 * z * z;
@@ -67,6 +69,45 @@ struct CornerSeenFromOtherCamera {
   }
 };
 
+CornerSeenFromOtherCamera seenFromOther(const MatchedCorners& from, const MatchedCorners& seen_by,
+                                        int i, bool into_reference, const CornerPairGates& gates) {
+  const double depth = seen_by.points(2, i);
+  const CameraIntrinsics& k = seen_by.intrinsics;
+  return {from.points.col(i),
+          seen_by.pixels.col(i),
+          depth,
+          seen_by.pixel_scales(i),
+          depthGate(depth, gates) / kDepthGateSigmas,
+          k.fx,
+          k.fy,
+          k.cx,
+          k.cy,
+          into_reference};
+}
+
+// Every used pair's six residuals (both cameras) at T, each block of three scaled by its weight.
+Eigen::VectorXd weightedResiduals(const MatchedCorners& reference, const MatchedCorners& current,
+                                  const std::vector<int>& used, const Eigen::Isometry3d& T,
+                                  const std::vector<double>& weights,
+                                  const CornerPairGates& gates) {
+  const Eigen::AngleAxisd angle_axis(T.rotation());
+  const Eigen::Vector3d rotation = angle_axis.angle() * angle_axis.axis();
+  const Eigen::Vector3d translation = T.translation();
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(6 * static_cast<Eigen::Index>(used.size()));
+  for (size_t j = 0; j < used.size(); ++j) {
+    for (int side = 0; side < 2; ++side) {
+      const CornerSeenFromOtherCamera residual =
+          side == 0 ? seenFromOther(current, reference, used[j], true, gates)
+                    : seenFromOther(reference, current, used[j], false, gates);
+      double r[3] = {0, 0, 0};
+      if (residual(rotation.data(), translation.data(), r))
+        for (int c = 0; c < 3; ++c)
+          out(6 * static_cast<Eigen::Index>(j) + 3 * side + c) = weights[2 * j + side] * r[c];
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<int> cornerPairsAgreeing(const MatchedCorners& reference, const MatchedCorners& current,
@@ -95,12 +136,8 @@ Eigen::Isometry3d refineCornerPairPose(const MatchedCorners& reference,
   ceres::Problem problem;
   const auto add = [&](const MatchedCorners& from, const MatchedCorners& seen_by, int i,
                        bool into_reference) {
-    const double depth = seen_by.points(2, i);
-    const CameraIntrinsics& k = seen_by.intrinsics;
     auto* cost = new ceres::AutoDiffCostFunction<CornerSeenFromOtherCamera, 3, 3, 3>(
-        new CornerSeenFromOtherCamera{
-            from.points.col(i), seen_by.pixels.col(i), depth, seen_by.pixel_scales(i),
-            depthGate(depth, gates) / kDepthGateSigmas, k.fx, k.fy, k.cx, k.cy, into_reference});
+        new CornerSeenFromOtherCamera(seenFromOther(from, seen_by, i, into_reference, gates)));
     problem.AddResidualBlock(cost, new ceres::HuberLoss(1.0), rotation.data(), translation.data());
   };
   for (const int i : used) {
@@ -123,6 +160,34 @@ Eigen::Isometry3d refineCornerPairPose(const MatchedCorners& reference,
     refined.linear() = Eigen::AngleAxisd(angle, rotation / angle).toRotationMatrix();
   refined.translation() = translation;
   return refined;
+}
+
+Matrix6d cornerPairInformation(const MatchedCorners& reference, const MatchedCorners& current,
+                               const std::vector<int>& used,
+                               const Eigen::Isometry3d& T_reference_current,
+                               const CornerPairGates& gates) {
+  if (used.empty())
+    return Matrix6d::Zero();
+  // The Huber weights at the pose (loss at one standard deviation): a block of norm s > 1 has its
+  // squared residual counted 1 / s, so its residuals 1 / sqrt(s).
+  std::vector<double> weights(2 * used.size(), 1.0);
+  const Eigen::VectorXd unweighted =
+      weightedResiduals(reference, current, used, T_reference_current, weights, gates);
+  for (size_t block = 0; block < weights.size(); ++block) {
+    const double norm = unweighted.segment<3>(3 * static_cast<Eigen::Index>(block)).norm();
+    weights[block] = norm > 1.0 ? 1.0 / std::sqrt(norm) : 1.0;
+  }
+  Eigen::MatrixXd jacobian(unweighted.size(), 6);
+  for (int d = 0; d < 6; ++d) {
+    Vector6d step = Vector6d::Zero();
+    step(d) = kInformationStep;
+    jacobian.col(d) = (weightedResiduals(reference, current, used,
+                                         expSE3(step) * T_reference_current, weights, gates) -
+                       weightedResiduals(reference, current, used,
+                                         expSE3(-step) * T_reference_current, weights, gates)) /
+                      (2 * kInformationStep);
+  }
+  return jacobian.transpose() * jacobian;
 }
 
 }  // namespace quadric_slam

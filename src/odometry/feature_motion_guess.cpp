@@ -232,6 +232,7 @@ FeatureMotionGuess FeatureMotionGuesser::guess(const FeatureFrame& reference,
     out.message = "the agreeing corners lie along one line";
     return out;
   }
+  out.information = cornerPairInformation(out.reference, out.current, best, T, gates);
   out.found = true;
   return out;
 }

@@ -89,6 +89,8 @@ void readOdometryParams(const ParamReader& reader, OdometryTracker::Params& para
   readParam(reader, "feature_pose_sigma_rotation", params.feature_pose_sigma_rotation, log);
   readParam(reader, "feature_max_speed", params.feature_max_speed, log);
   readParam(reader, "feature_max_turn_rate", params.feature_max_turn_rate, log);
+  readParam(reader, "feature_fusion_icp_bias_per_z2", params.feature_fusion_icp_bias_per_z2, log);
+  readParam(reader, "feature_fusion_corner_floor", params.feature_fusion_corner_floor, log);
   readParam(reader, "increment_covariance_scale", params.increment_covariance_scale, log);
   readParam(reader, "increment_translation_fraction", params.increment_translation_fraction, log);
   readParam(reader, "increment_rotation_per_metre", params.increment_rotation_per_metre, log);

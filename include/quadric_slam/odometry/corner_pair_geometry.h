@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <vector>
 
+#include "quadric_slam/geometry/se3.h"
 #include "quadric_slam/types/camera_intrinsics.h"
 
 namespace quadric_slam {
@@ -47,5 +48,14 @@ Eigen::Isometry3d refineCornerPairPose(const MatchedCorners& reference,
                                        const MatchedCorners& current, const std::vector<int>& used,
                                        const Eigen::Isometry3d& T_reference_current,
                                        const CornerPairGates& gates);
+
+// The information (inverse covariance) the pairs `used` give T_reference_current, for its left
+// perturbation xi = (v, omega) in the reference frame, T = exp(xi^) T_hat (the ICP's convention,
+// odometry/point_to_plane_icp.h): J^T W J of the residuals refineCornerPairPose minimises, J by
+// central differences, W the Huber weights at T.
+Matrix6d cornerPairInformation(const MatchedCorners& reference, const MatchedCorners& current,
+                               const std::vector<int>& used,
+                               const Eigen::Isometry3d& T_reference_current,
+                               const CornerPairGates& gates);
 
 }  // namespace quadric_slam

@@ -48,6 +48,9 @@ struct FeatureMotionGuess {
   std::string message;  // why nothing was found (empty when found)
   // The matched corners (columns in match order), to judge other poses by them.
   MatchedCorners reference, current;
+  // What the agreeing corners say of T_reference_current: the information of its left
+  // perturbation (odometry/corner_pair_geometry.h cornerPairInformation).
+  Matrix6d information = Matrix6d::Zero();
 };
 
 class FeatureMotionGuesser {

@@ -87,6 +87,16 @@ class OdometryTracker {
     // alone also needs twice min_inliers agreeing, half of the matches.
     double feature_max_speed = 1.5;
     double feature_max_turn_rate = 2.0;
+    // Where a strong corners' guess was made (a step of feature_min_interval or more), the
+    // alignment's pose and the corners' are fused, each weighed by its information. ICP's
+    // covariance (from its residuals) misses the bias between views far apart: the depth's
+    // low-frequency distortion differs with the image position, about a centimetre at 3 m on a
+    // Kinect v1, so feature_fusion_icp_bias_per_z2 z^2 (m; z the frame's median depth) is added to
+    // its translation's standard deviation, and that over z to its rotation's. The corners'
+    // (from their reprojections and depths) is floored at feature_fusion_corner_floor (m; over z
+    // for the rotation). [0, inf) 1/m and (0, inf) m.
+    double feature_fusion_icp_bias_per_z2 = 0.002;
+    double feature_fusion_corner_floor = 0.003;
     // The ICP's normals from the frame's fitted surfaces (odometry/surface_normals.h): track()
     // does not change its cloud, so the caller calls adoptSurfaceNormals() before it (QuadricSlam
     // and the odometry nodelet do).
@@ -241,6 +251,10 @@ class OdometryTracker {
   void alignFromEarlierKeyframes(const Cloud& cloud,
                                  const std::function<FeatureFrame*()>& frame_features,
                                  PointToPlaneIcp::Result& best, Result& out);
+  // The alignment's pose T_keyframe_current fused with the corners' guess in out (a strong one),
+  // each by its information (Params::feature_fusion_*); depth: the frame's median depth (m).
+  Eigen::Isometry3d fusedWithCorners(const PointToPlaneIcp::Result& icp, const Result& out,
+                                     double depth) const;
   // A degenerate alignment at the corners' pose, with the feature_pose_sigma_* covariance.
   PointToPlaneIcp::Result placedByCorners(const Eigen::Isometry3d& T_keyframe_current,
                                           int keyframes_back) const;
