@@ -108,7 +108,9 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
 
   // The sequence has RGB (registered, rgb.txt): the reconstruction's points carry the colours of
   // their pixels (alpha 255), which are the rendered surfaces' shades, not the landmark colours.
-  // Without RGB (--no-rgb) the same frames give the same map, every point in its landmark's colour.
+  // Without RGB (--no-rgb) the same frames give the same map, every point in its landmark's colour
+  // (up to the corners' guess, which the image feeds at 10 Hz: the fused poses move by a fraction
+  // of a millimetre).
   const auto colouredShare = [](const fs::path& pcd, std::size_t* points) {
     pcl::PointCloud<pcl::PointXYZRGBL> cloud;
     if (pcl::io::loadPCDFile(pcd.string(), cloud) != 0)
@@ -124,8 +126,9 @@ TEST(RunBagMapping, DeskSequenceBuildsAMapOfTheScene) {
   const std::string depth_only = runBag("out_depth", gt_option + " --quiet --no-rgb");
   ASSERT_EQ(code, 0) << depth_only;
   EXPECT_EQ(colouredShare(dir / "out_depth/reconstruction.pcd", &points_depth), 0.0);
-  EXPECT_EQ(points_depth, points_rgb);
-  EXPECT_EQ(valueAfter(depth_only, "map_ate_rmse_m"), map_ate);
+  EXPECT_NEAR(static_cast<double>(points_depth), static_cast<double>(points_rgb),
+              0.005 * static_cast<double>(points_rgb));
+  EXPECT_NEAR(valueAfter(depth_only, "map_ate_rmse_m"), map_ate, 0.0005);
   EXPECT_EQ(quadric_slam::readMapYaml((dir / "out_depth/map.yaml").string()).quadrics.size(),
             map.quadrics.size());
 
