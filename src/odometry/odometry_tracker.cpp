@@ -27,7 +27,7 @@ constexpr double kPlacementInlierShare = 0.5;
 // Earlier keyframes are screened with every kHistoryScreenStride-th corner of the frame; those
 // with at least kHistoryScreenMinMatches matches, at most kHistoryKeyframesGuessed of them (the
 // most matched), are asked for a full guess.
-constexpr int kHistoryScreenStride = 8;
+constexpr int kHistoryScreenStride = 16;
 constexpr int kHistoryScreenMinMatches = 3;
 constexpr int kHistoryKeyframesGuessed = 3;
 // A degenerate pose must keep this share of the keyframe's corners' agreeing matches.
