@@ -11,6 +11,8 @@
 #include "quadric_slam/odometry/corner_pair_geometry.h"
 #include "quadric_slam/odometry/pose_math.h"
 
+#include "axis_angle_motion.h"
+
 namespace quadric_slam {
 namespace {
 
@@ -20,13 +22,7 @@ double depthNoise(double z) {
   return 1.5 * (0.0012 + 0.0019 * (z - 0.4) * (z - 0.4));
 }
 
-Eigen::Isometry3d motion(const Eigen::Vector3d& translation, const Eigen::Vector3d& axis,
-                         double degrees) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(degrees * M_PI / 180.0, axis.normalized()).toRotationMatrix();
-  T.translation() = translation;
-  return T;
-}
+using test::motion;
 
 struct CornerPairs {
   MatchedCorners reference, current;

@@ -13,6 +13,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "axis_angle_motion.h"
 #include "quadric_slam/frontend/normal_estimator.h"
 #include "quadric_slam/io/depth_png.h"
 #include "quadric_slam/io/frame_source.h"
@@ -62,13 +63,7 @@ cv::Mat zeroForNaN(const cv::Mat& depth_m) {
   return out;
 }
 
-Eigen::Isometry3d motion(const Eigen::Vector3d& translation, const Eigen::Vector3d& axis,
-                         double degrees) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(degrees * M_PI / 180.0, axis.normalized()).toRotationMatrix();
-  T.translation() = translation;
-  return T;
-}
+using test::motion;
 
 double translationError(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return (a.inverse() * b).translation().norm();
