@@ -311,16 +311,16 @@ Eigen::Isometry3d OdometryTracker::cornersReferenceFromKeyframe(const Result& ou
 }
 
 Eigen::Isometry3d OdometryTracker::fusedWithCorners(const PointToPlaneIcp::Result& icp,
-                                                    const Result& out, double depth) const {
+                                                    const FeatureMotionGuess& corners,
+                                                    const Eigen::Isometry3d& T_corners_keyframe,
+                                                    double depth) const {
   // Both as left perturbations in the keyframe frame (the ICP's convention): an earlier
   // keyframe's guess is carried over by the adjoint, xi_keyframe = Ad(T_keyframe_earlier) xi.
-  const Eigen::Isometry3d T_corners_keyframe = cornersReferenceFromKeyframe(out);
   const Eigen::Isometry3d T_keyframe_corners =
-      T_corners_keyframe.inverse() * out.feature_guess.T_reference_current;
+      T_corners_keyframe.inverse() * corners.T_reference_current;
   const Matrix6 carry_back = adjointSE3(T_corners_keyframe);  // = Ad(T_keyframe_earlier)^-1
-  Matrix6 corners_covariance = (carry_back.transpose() * out.feature_guess.information * carry_back)
-                                   .ldlt()
-                                   .solve(Matrix6::Identity());
+  Matrix6 corners_covariance =
+      (carry_back.transpose() * corners.information * carry_back).ldlt().solve(Matrix6::Identity());
   const double corner_floor = params_.feature_fusion_corner_floor;
   corners_covariance.diagonal().head<3>().array() += corner_floor * corner_floor;
   corners_covariance.diagonal().tail<3>().array() += std::pow(corner_floor / depth, 2);
@@ -530,6 +530,8 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   // repetitively textured wall have minima tens of centimetres apart, the corners one.
   // (An earlier keyframe's corners judge the same way, the pose carried into that keyframe.)
   const Eigen::Isometry3d T_corners_keyframe = cornersReferenceFromKeyframe(out);
+  const Eigen::Isometry3d T_keyframe_corners =
+      T_corners_keyframe.inverse() * out.feature_guess.T_reference_current;
   const auto cornersAgree = [&](const Eigen::Isometry3d& T_keyframe_current) {
     return !out.feature_guess.found ||
            kCornerAgreementShare * out.feature_guess.inliers <=
@@ -549,7 +551,7 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
     std::vector<Eigen::Isometry3d> others = {T_keyframe_odom * prediction,
                                              T_keyframe_odom * T_odom_camera_};
     if (out.feature_guess.found)
-      others.push_back(T_corners_keyframe.inverse() * out.feature_guess.T_reference_current);
+      others.push_back(T_keyframe_corners);
     for (const Eigen::Isometry3d& other : others) {
       const Eigen::Isometry3d moved =
           priorAlongFreeDirections(icp.T_reference_current, other, free);
@@ -580,8 +582,6 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   if (icp.status == TrackingStatus::kDegenerate && !photometric &&
       !cornersAgree(icp.T_reference_current)) {
     // The corners measured the directions the depth left free.
-    const Eigen::Isometry3d T_keyframe_corners =
-        T_corners_keyframe.inverse() * out.feature_guess.T_reference_current;
     const Eigen::Isometry3d moved = priorAlongFreeDirections(
         icp.T_reference_current, T_keyframe_corners,
         freeDirections(icp.covariance, params_.icp.degenerate_variance, kFreeVarianceFraction));
@@ -600,7 +600,8 @@ OdometryTracker::Result OdometryTracker::track(const Cloud& cloud,
   // 1-4 cm per step on generated far walls where the corners were within 0.2-1.5 cm.
   if (out.feature_guess.found && strongGuess(out.feature_guess) &&
       icp.status != TrackingStatus::kLost && !out.placed_by_features)
-    icp.T_reference_current = fusedWithCorners(icp, out, medianDepth(cloud));
+    icp.T_reference_current =
+        fusedWithCorners(icp, out.feature_guess, T_corners_keyframe, medianDepth(cloud));
   const Eigen::Isometry3d previous = T_odom_camera_;
   bool new_keyframe = false;
   // The increment T_previous_this and its covariance (Result::increment_covariance).

@@ -91,8 +91,8 @@ class OdometryTracker {
     // alignment's pose and the corners' are fused, each weighed by its information. ICP's
     // covariance (from its residuals) misses the bias between views far apart: the depth's
     // low-frequency distortion differs with the image position, about a centimetre at 3 m on a
-    // Kinect v1, so feature_fusion_icp_bias_per_z2 z^2 (m; z the frame's median depth) is added to
-    // its translation's standard deviation, and that over z to its rotation's. The corners'
+    // Kinect v1, so feature_fusion_icp_bias_per_z2 z^2 (m; z the frame's median depth, m) is added
+    // to its translation's standard deviation, and that over z to its rotation's. The corners'
     // (from their reprojections and depths) is floored at feature_fusion_corner_floor (m; over z
     // for the rotation). [0, inf) 1/m and (0, inf) m.
     double feature_fusion_icp_bias_per_z2 = 0.002;
@@ -244,16 +244,20 @@ class OdometryTracker {
                                              const std::function<FeatureFrame*()>& frame_features,
                                              Result& out);
   // The corners of earlier keyframes (feature_history_keyframes) when the keyframe's gave no
-  // guess or a weak one, or every alignment is lost: ICP from the guess with the most agreeing
-  // matches within the camera's speed (when it has more than the keyframe's), kept when its
-  // corners agree with it better than with best; when no alignment holds and the guess is
-  // strong, the frame is placed by the corners alone.
+  // guess or a weak one, or every alignment is lost: screened with a sample of the frame's
+  // corners, the few sharing the most are asked, and ICP runs from the guess with the most
+  // agreeing matches within the camera's speed (when it has more than the keyframe's); kept when
+  // its corners agree with it better than with best and it keeps half of a strong guess's; when
+  // no alignment does and the guess is strong, the frame is placed by the corners alone.
   void alignFromEarlierKeyframes(const Cloud& cloud,
                                  const std::function<FeatureFrame*()>& frame_features,
                                  PointToPlaneIcp::Result& best, Result& out);
-  // The alignment's pose T_keyframe_current fused with the corners' guess in out (a strong one),
-  // each by its information (Params::feature_fusion_*); depth: the frame's median depth (m).
-  Eigen::Isometry3d fusedWithCorners(const PointToPlaneIcp::Result& icp, const Result& out,
+  // The alignment's pose T_keyframe_current fused with a strong corners' guess (made against the
+  // keyframe T_corners_keyframe relates to, cornersReferenceFromKeyframe), each by its information
+  // (Params::feature_fusion_*); depth: the frame's median depth (m).
+  Eigen::Isometry3d fusedWithCorners(const PointToPlaneIcp::Result& icp,
+                                     const FeatureMotionGuess& corners,
+                                     const Eigen::Isometry3d& T_corners_keyframe,
                                      double depth) const;
   // A degenerate alignment at the corners' pose, with the feature_pose_sigma_* covariance.
   PointToPlaneIcp::Result placedByCorners(const Eigen::Isometry3d& T_keyframe_current,
