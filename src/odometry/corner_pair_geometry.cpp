@@ -12,6 +12,7 @@ namespace {
 constexpr double kMinProjectedDepth = 0.05;
 // The depth gate spans this many standard deviations of the depth noise.
 constexpr double kDepthGateSigmas = 3.0;
+// Iterations of the refinement (Levenberg-Marquardt from a start within the gates).
 constexpr int kRefinementIterations = 20;
 // Central-difference step of the information's Jacobian (m, rad).
 constexpr double kInformationStep = 1e-6;
