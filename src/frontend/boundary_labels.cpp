@@ -29,8 +29,7 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
   // A pixel may join when it is unlabelled, has depth in range and no normal. Only pixels next to
   // the labels are examined (the label image is read first, the cloud only there), so the work
   // follows the rim, not the image.
-  const auto mayJoin = [&](int index) {
-    const pcl::PointNormal& q = cloud.points[index];
+  const auto mayJoin = [&](const pcl::PointNormal& q) {
     return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
            q.z >= settings.min_range && q.z <= settings.max_range && !std::isfinite(q.normal_x);
   };
@@ -61,7 +60,13 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
         out[u + 1] = 1;
     }
   }
-  std::vector<int> front;
+  // A candidate keeps its point: the ring reads it again only after the whole image was scanned,
+  // when the cloud's memory there has left the cache.
+  struct Candidate {
+    int index;
+    Eigen::Vector3f point;
+  };
+  std::vector<Candidate> front;
   for (int v = 0; v < height; ++v) {
     const std::uint16_t* row = labels.ptr<std::uint16_t>(v);
     const std::uint8_t* above = &near_row[static_cast<std::size_t>(std::max(0, v - 1)) * width];
@@ -70,19 +75,20 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
         &near_row[static_cast<std::size_t>(std::min(height - 1, v + 1)) * width];
     for (int u = 0; u < width; ++u) {
       const int index = v * width + u;
-      if (row[u] == 0 && (above[u] | here[u] | below[u]) != 0 && mayJoin(index)) {
+      if (row[u] == 0 && (above[u] | here[u] | below[u]) != 0 && mayJoin(cloud.points[index])) {
         queued[index] = 1;
-        front.push_back(index);
+        front.push_back({index, cloud.points[index].getVector3fMap()});
       }
     }
   }
   for (int ring = 0; ring < settings.rings && !front.empty(); ++ring) {
     // Each ring reads the labels of the previous one only, so growth is one pixel per ring.
-    std::vector<std::pair<int, std::uint16_t>> joined;
-    for (const int index : front) {
-      const pcl::PointNormal& q = cloud.points[index];
-      const Eigen::Vector3d point(q.x, q.y, q.z);
-      const double threshold = depthThreshold(q.z, settings.distance_factor, settings.min_distance);
+    std::vector<std::pair<Candidate, std::uint16_t>> joined;
+    for (const Candidate& candidate : front) {
+      const int index = candidate.index;
+      const Eigen::Vector3d point = candidate.point.cast<double>();
+      const double threshold =
+          depthThreshold(point.z(), settings.distance_factor, settings.min_distance);
       double best_distance = threshold;
       std::uint16_t best = 0;
       std::uint16_t tried[8];  // each bordering surface is measured once
@@ -100,18 +106,18 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
         }
       });
       if (best != 0)
-        joined.emplace_back(index, best);
+        joined.push_back({candidate, best});
       else
         queued[index] = 0;  // may be reached again from a neighbour that joins later
     }
-    std::vector<int> next_front;
-    for (const auto& [index, label] : joined) {
+    std::vector<Candidate> next_front;
+    for (const auto& [candidate, label] : joined) {
+      const int index = candidate.index;
       const int u = index % width, v = index / width;
       labels.at<std::uint16_t>(v, u) = label;
       QuadricDetection& detection = segmentation.detections[label - 1];
       ++detection.num_points;
-      const pcl::PointNormal& q = cloud.points[index];
-      const Eigen::Vector3d local = T_quadric_camera[label - 1] * Eigen::Vector3d(q.x, q.y, q.z);
+      const Eigen::Vector3d local = T_quadric_camera[label - 1] * candidate.point.cast<double>();
       detection.extent_min = detection.extent_min.cwiseMin(local);
       detection.extent_max = detection.extent_max.cwiseMax(local);
       ImageRoi& roi = detection.roi;
@@ -122,11 +128,12 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
       roi.width = x1 - roi.x_offset + 1;
       roi.height = y1 - roi.y_offset + 1;
     }
-    for (const auto& [index, label] : joined) {
-      forEachNeighbour(index, [&](int neighbour, int nu, int nv) {
-        if (!queued[neighbour] && labels.at<std::uint16_t>(nv, nu) == 0 && mayJoin(neighbour)) {
+    for (const auto& [candidate, label] : joined) {
+      forEachNeighbour(candidate.index, [&](int neighbour, int nu, int nv) {
+        if (!queued[neighbour] && labels.at<std::uint16_t>(nv, nu) == 0 &&
+            mayJoin(cloud.points[neighbour])) {
           queued[neighbour] = 1;
-          next_front.push_back(neighbour);
+          next_front.push_back({neighbour, cloud.points[neighbour].getVector3fMap()});
         }
       });
     }

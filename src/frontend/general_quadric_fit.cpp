@@ -60,6 +60,21 @@ double GeneralQuadricFit::distance(const Eigen::Vector3d& p) const {
   return spread * sampsonDistance(coefficients, (p - centre) / spread);
 }
 
+Eigen::Matrix4d GeneralQuadricFit::matrix() const {
+  const Vector10d& c = coefficients;
+  // In normalised coordinates y = (p - centre) / spread: f = y^T A y + 2 b^T y + d.
+  Eigen::Matrix4d normalised;
+  normalised << c[0], c[3] / 2, c[4] / 2, c[6] / 2,  //
+      c[3] / 2, c[1], c[5] / 2, c[7] / 2,            //
+      c[4] / 2, c[5] / 2, c[2], c[8] / 2,            //
+      c[6] / 2, c[7] / 2, c[8] / 2, c[9];
+  // y = N p with N = [I / spread, -centre / spread; 0 1].
+  Eigen::Matrix4d N = Eigen::Matrix4d::Identity() / spread;
+  N.block<3, 1>(0, 3) = -centre / spread;
+  N(3, 3) = 1.0;
+  return N.transpose() * normalised * N;
+}
+
 Eigen::Vector3d GeneralQuadricFit::gradientDirection(const Eigen::Vector3d& p) const {
   Eigen::Vector3d g;
   value(coefficients, (p - centre) / spread, &g);

@@ -21,6 +21,8 @@ struct GeneralQuadricFit {
   bool ok = false;   // false for fewer than 20 points
   // Sampson distance (m) of a point.
   double distance(const Eigen::Vector3d& p) const;
+  // The quadric as x^T Q x = 0 in the points' coordinates (x homogeneous).
+  Eigen::Matrix4d matrix() const;
   // Unit gradient of f at a point (the quadric's normal direction there; zero where f is flat).
   Eigen::Vector3d gradientDirection(const Eigen::Vector3d& p) const;
 };

@@ -1,0 +1,35 @@
+// A cylinder's narrow strip 1.8-2.2 m away at the image's edge under the harsh (real-like) depth
+// model: the open waste bin of the generated desk at 1 Hz for 30 s (seed 1, the sequence of
+// docs/segmentation/README.md). The correlated noise bends the strip so that a general quadric fits
+// it with a third less RMS by its first-order (Sampson) distance, which made the shape test drop
+// the cylinder in 7 of the bin's 11 frames; along the rays, where the sensor errs, that quadric
+// explains the depths no better (a tenth to a quarter of the rays miss it), and the cylinder stays
+// (frontend/ray_residual.h). Now 10 of 11.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <optional>
+#include <string>
+
+#include "synth_sequence_score.h"
+
+namespace qs = quadric_slam;
+
+TEST(QuadricSegmenterFarBin, TheDesksOpenBinIsACylinder) {
+  if (qs::test::synthTool().empty())
+    GTEST_SKIP() << "the synth tool is not built beside this test";
+  const std::string scene = std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/desk.yaml";
+  const std::optional<qs::SegmentationScore> scored = qs::test::scoreSynthSequence(
+      "segmenter_far_bin", "--scene " + scene + " --seconds 30 --rate 1 --no-bag --seed 1", 2000,
+      2.0);
+  ASSERT_TRUE(scored);
+  std::printf("%s", scored->report().c_str());
+  // The generator numbers surfaces in the scene file's order (a box gives six): the bin is 23.
+  constexpr int kBin = 23;
+  const auto bin = scored->surfaces().find(kBin);
+  ASSERT_NE(bin, scored->surfaces().end());
+  ASSERT_EQ(bin->second.quadric_class, "cylinder");
+  EXPECT_GE(bin->second.frames_scored, 10) << "the bin is in view in a third of the sequence";
+  EXPECT_GE(bin->second.rate(), 0.85);
+  EXPECT_LE(scored->spuriousPerFrame(), 0.3);
+}
