@@ -250,7 +250,16 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
   PrimitiveShape shape = candidate.shape;
   if (shape.quadric_class == QuadricClass::kCone && shape.size < p.min_cone_half_angle)
     shape = cylinderFromCone(shape, support);
-  ShapeRefiner::Result fit = refiner.refine(shape, support);
+  // A cone that refines thinner than the least half angle is a cylinder (the side of a cylinder
+  // proposed as a slightly tapering cone): refined as one rather than dropped as implausible.
+  const auto refine = [&](const PrimitiveShape& start, const std::vector<Eigen::Vector3d>& on) {
+    ShapeRefiner::Result result = refiner.refine(start, on);
+    if (result.shape.quadric_class == QuadricClass::kCone &&
+        result.shape.size < p.min_cone_half_angle)
+      result = refiner.refine(cylinderFromCone(result.shape, on), on);
+    return result;
+  };
+  ShapeRefiner::Result fit = refine(shape, support);
   const ImageRoi roi = grown(roiOf(pixels, width), 4 * p.cgal_stride, width, height);
   verdict.read_box = unite(verdict.read_box, roi);
 
@@ -265,7 +274,7 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
       break;
     }
     points = pointsOf(cloud, indices);
-    fit = refiner.refine(fit.shape, points);
+    fit = refine(fit.shape, points);
     // Model selection on the first support only: the second pass re-assigns the pixels with
     // the chosen class and refines it there (selecting again there changed nothing measurable
     // on the generated scenes' recall, at a third of the verification's time).

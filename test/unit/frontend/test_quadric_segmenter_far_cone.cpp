@@ -13,7 +13,7 @@
 
 namespace qs = quadric_slam;
 
-TEST(QuadricSegmenterFarCone, TheRoomsConeIsAConeByItsOutline) {
+TEST(QuadricSegmenterFarCone, TheRoomsConeIsAConeByItsOutlineAndItsCylinderACylinder) {
   if (qs::test::synthTool().empty())
     GTEST_SKIP() << "the synth tool is not built beside this test";
   const std::string scene = std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/room.yaml";
@@ -22,8 +22,12 @@ TEST(QuadricSegmenterFarCone, TheRoomsConeIsAConeByItsOutline) {
       2.0);
   ASSERT_TRUE(scored);
   std::printf("%s", scored->report().c_str());
-  int cones = 0;
+  int cones = 0, cylinders = 0;
   for (const auto& [id, surface] : scored->surfaces()) {
+    if (surface.quadric_class == "cylinder") {
+      ++cylinders;
+      EXPECT_GE(surface.rate(), 0.95) << "surface " << id;
+    }
     if (surface.quadric_class != "cone")
       continue;
     ++cones;
@@ -31,5 +35,6 @@ TEST(QuadricSegmenterFarCone, TheRoomsConeIsAConeByItsOutline) {
     EXPECT_GE(surface.rate(), 0.85) << "surface " << id;
   }
   EXPECT_EQ(cones, 1);
+  EXPECT_EQ(cylinders, 1);
   EXPECT_LE(scored->spuriousPerFrame(), 0.15);
 }
