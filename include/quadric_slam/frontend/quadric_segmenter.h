@@ -141,13 +141,16 @@ class QuadricSegmenter {
     // A cylinder is also fitted as a cone (a truncated cone with a small half angle looks like a
     // cylinder) and becomes one when the cone's RMS is below its own / cylinder_rms_ratio or the
     // cone is significantly better over the independent points (curved_model_selection.h).
+    // A plane CGAL finds on bending normals becomes a cylinder candidate when the normals'
+    // cylinder fits better, or within plane_rms_ratio where the depth noise exceeds cgal_epsilon.
     double plane_rms_ratio = 1.5;
     double cylinder_rms_ratio = 1.15;
     // Shape test: a curved fit whose RMS exceeds quadric_rms_ratio times that of a general quadric
     // fitted to the same points (general_quadric_fit.h) has residuals of shape, not noise (e.g. a
     // sphere on an ellipsoid) and is dropped; not when the general quadric fits the noise band
     // with two close sheets that split neighbouring points (under 3/4 of the grid neighbours on
-    // one sheet), which undercuts any true surface's RMS. >= 1; default 1.3.
+    // one sheet), which undercuts any true surface's RMS, nor when along the pixels' rays it
+    // explains the depths no better than the fit (ray_residual.h). >= 1; default 1.3.
     double quadric_rms_ratio = 1.3;
     // Report what the shape test finds as a detection of class general when the general quadric
     // is an ellipsoid with semi-axes within [min_sphere_radius, max_sphere_radius]
