@@ -136,7 +136,14 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
   // A thin cone is a cylinder when the cylinder fits almost as well, unless the cone is
   // significantly better over all the points.
   if (fit.shape.quadric_class == QuadricClass::kCone) {
-    const auto as_cylinder = alternatives.screen(cylinderFromCone(fit.shape, points));
+    // From the cone's axis, and from the normals alone: a wide cone fitted to a cylinder's strip
+    // has its axis far from the cylinder's, where the first start cannot find it.
+    std::optional<ShapeRefiner::Result> as_cylinder =
+        alternatives.screen(cylinderFromCone(fit.shape, points));
+    const auto from_normals = alternatives.screen(
+        cylinderFromNormals(points, normals, cylinderCurvatureFromNormals(points, normals)));
+    if (from_normals && (!as_cylinder || from_normals->rms < as_cylinder->rms))
+      as_cylinder = from_normals;
     const double cone_rms = alternatives.sampleRms(fit);
     if (as_cylinder && as_cylinder->rms < ratio * cone_rms &&
         !coneSignificantlyBetter(cone_rms, as_cylinder->rms, points.size(), p) &&

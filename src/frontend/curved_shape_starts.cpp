@@ -148,6 +148,36 @@ PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
   return cylinder;
 }
 
+double cylinderCurvatureFromNormals(const std::vector<Eigen::Vector3d>& points,
+                                    const std::vector<Eigen::Vector3d>& normals) {
+  if (points.size() < 10 || points.size() != normals.size())
+    return 0.0;
+  Eigen::Matrix3d N = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d mean_point = Eigen::Vector3d::Zero(), mean_normal = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    N += normals[i] * normals[i].transpose();
+    mean_point += points[i];
+    mean_normal += normals[i];
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(N);
+  if (eig.info() != Eigen::Success)
+    return 0.0;
+  const Eigen::Vector3d axis = eig.eigenvectors().col(0);
+  const double n = static_cast<double>(points.size());
+  mean_point /= n;
+  mean_normal /= n;
+  // Normals turned towards the camera point out of a cylinder's outside: the regression's sign
+  // does not matter for the curvature's size.
+  double cross = 0, squares = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    Eigen::Vector3d dp = points[i] - mean_point;
+    dp -= axis.dot(dp) * axis;
+    cross += (normals[i] - mean_normal).dot(dp);
+    squares += dp.squaredNorm();
+  }
+  return squares > 0 ? std::abs(cross) / squares : 0.0;
+}
+
 double shapeCurvature(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points) {
   if (shape.quadric_class != QuadricClass::kCone)
     return shape.size > 0 ? 1.0 / shape.size : 0.0;

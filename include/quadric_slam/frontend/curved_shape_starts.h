@@ -44,6 +44,13 @@ PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
 PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
                                    const std::vector<Eigen::Vector3d>& normals, double curvature);
 
+// The curvature (1/m) with which the normals turn across the points as on a cylinder: about the
+// least-variance direction of the normals (the axis), the normals' deviations from their mean
+// regressed on the points' deviations perpendicular to it (n = (p - c) / r on a cylinder's
+// outside). 0 when degenerate or when the normals do not turn outwards.
+double cylinderCurvatureFromNormals(const std::vector<Eigen::Vector3d>& points,
+                                    const std::vector<Eigen::Vector3d>& normals);
+
 // The largest principal curvature of a curved shape over its support (1/m): 1/r for a sphere or
 // cylinder, cos(half angle) / (distance to the axis) for a cone (mean over the points).
 double shapeCurvature(const PrimitiveShape& shape, const std::vector<Eigen::Vector3d>& points);

@@ -1,10 +1,12 @@
 // Model selection among the curved classes (curved_model_selection.h) on noisy samples of the
 // visible side of a surface, started from the wrong class: a cone fitted as a cylinder becomes a
 // cone, a cylinder fitted as a cone becomes a cylinder, a sphere cap fitted as a cylinder becomes a
-// sphere, and a cylinder fitted as a cylinder stays one.
+// sphere, a cylinder fitted as a wide cone (axis far from its own) becomes the cylinder, and a
+// cylinder fitted as a cylinder stays one.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "axial_surface_samples.h"
@@ -103,4 +105,25 @@ TEST(CurvedModelSelection, CylinderStaysCylinder) {
   ASSERT_EQ(result.shape.quadric_class, QuadricClass::kCylinder);
   EXPECT_NEAR(result.shape.size, radius, 0.001);
   EXPECT_LT(result.rms, 0.0012);
+}
+
+// A wide cone fitted to a narrow cylinder's strip (CGAL proposes one on a tube lying on a desk):
+// its axis lies far from the cylinder's, the cylinder around it does not fit, and the cylinder the
+// normals describe is the start that finds the tube.
+TEST(CurvedModelSelection, CylinderFittedAsAWideConeBecomesCylinder) {
+  const double radius = 0.04;
+  const Samples s = axialSurface(false, radius, -0.15, 0.15, 0.001, 5);
+  // A cone whose axis crosses the tube's, apex to one side: it refines to a wide cone (about 1 rad)
+  // through the strip.
+  const PrimitiveShape start = PrimitiveShape::cone(kAxisPoint + Eigen::Vector3d(0.3, 0.0, 0.0),
+                                                    Eigen::Vector3d(-1, 0, 0), 0.3);
+  const qs::ShapeRefiner refiner;
+  const qs::ShapeRefiner::Result cone = refiner.refine(start, s.points);
+  ASSERT_EQ(cone.shape.quadric_class, QuadricClass::kCone);
+  ASSERT_LT(cone.shape.size, params().max_cone_half_angle) << "a plausible cone";
+  std::printf("the wide cone: half angle %.3f, RMS %.4f m\n", cone.shape.size, cone.rms);
+  const qs::ShapeRefiner::Result result =
+      qs::selectCurvedModel(cone, s.points, s.normals, params(), refiner);
+  ASSERT_EQ(result.shape.quadric_class, QuadricClass::kCylinder);
+  EXPECT_NEAR(result.shape.size, radius, 0.002);
 }

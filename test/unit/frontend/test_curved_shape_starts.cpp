@@ -117,3 +117,22 @@ TEST(CurvedShapeStarts, ConeFromTiltedCylinderFindsTheOpeningACylinderFitHides) 
   EXPECT_LT(best_axis_error, 0.02);
   EXPECT_LT(best_rms, 0.8 * cylinder.rms);
 }
+
+TEST(CurvedShapeStarts, CylinderCurvatureFromNormalsIsOneOverTheRadius) {
+  const double radius = 0.06;
+  const Samples exact = axialSurface(false, radius, -0.2, 0.2, 0.0, 5);
+  EXPECT_NEAR(qs::cylinderCurvatureFromNormals(exact.points, exact.normals), 1.0 / radius, 1e-6);
+  const Samples noisy = axialSurface(false, radius, -0.2, 0.2, 0.002, 6);
+  EXPECT_NEAR(qs::cylinderCurvatureFromNormals(noisy.points, noisy.normals), 1.0 / radius,
+              0.1 / radius);
+  // A plane's normals do not turn; too few points are degenerate.
+  std::vector<Eigen::Vector3d> plane, normals;
+  for (int i = 0; i < 100; ++i) {
+    plane.emplace_back(0.01 * (i % 10), 0.01 * (i / 10), 1.5);
+    normals.emplace_back(0, 0, -1);
+  }
+  EXPECT_NEAR(qs::cylinderCurvatureFromNormals(plane, normals), 0.0, 1e-9);
+  EXPECT_EQ(qs::cylinderCurvatureFromNormals({plane.begin(), plane.begin() + 5},
+                                             {normals.begin(), normals.begin() + 5}),
+            0.0);
+}
