@@ -46,8 +46,8 @@ PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
 
 // The curvature (1/m) with which the normals turn across the points as on a cylinder: about the
 // least-variance direction of the normals (the axis), the normals' deviations from their mean
-// regressed on the points' deviations perpendicular to it (n = (p - c) / r on a cylinder's
-// outside). 0 when degenerate or when the normals do not turn outwards.
+// regressed on the points' deviations perpendicular to it (n = +-(p - c) / r: outside or inside
+// alike, the size of the slope). 0 when degenerate (fewer than 10 points, no spread).
 double cylinderCurvatureFromNormals(const std::vector<Eigen::Vector3d>& points,
                                     const std::vector<Eigen::Vector3d>& normals);
 
