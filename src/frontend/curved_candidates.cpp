@@ -45,22 +45,6 @@ std::vector<std::vector<int>> freeComponents(const SegmentationFrame& frame,
   return components;
 }
 
-namespace {
-
-// The sensor's depth noise (kinectDepthSigma) at the points' median depth.
-double depthSigmaAt(const std::vector<Eigen::Vector3d>& points, const QuadricSegmenter::Params& p) {
-  std::vector<double> z;
-  z.reserve(points.size());
-  for (const Eigen::Vector3d& q : points)
-    z.push_back(q.z());
-  if (z.empty())
-    return 0.0;
-  std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
-  return kinectDepthSigma(z[z.size() / 2], p.planes.noise_scale, p.planes.quantisation_factor);
-}
-
-}  // namespace
-
 CurvedCandidates findCurvedCandidates(const SegmentationFrame& frame,
                                       const QuadricSegmenter::Params& p) {
   CurvedCandidates out;
@@ -146,7 +130,9 @@ CurvedCandidates findCurvedCandidates(const SegmentationFrame& frame,
       // which flatters the plane: there the cylinder need only fit within plane_rms_ratio of it
       // (the verification's degeneracy test then decides on the surface's whole support).
       const PrimitiveShape cylinder = cylinderFromNormals(support, support_normals, curvature);
-      const double allowed = depthSigmaAt(support, p) > p.cgal_epsilon ? p.plane_rms_ratio : 1.0;
+      const double sigma = kinectDepthSigma(medianDepth(cloud, pixels), p.planes.noise_scale,
+                                            p.planes.quantisation_factor);
+      const double allowed = sigma > p.cgal_epsilon ? p.plane_rms_ratio : 1.0;
       if (plausibleShape(cylinder, p) &&
           rmsDistance(cylinder, support) < allowed * rmsDistance(shape.shape, support))
         shape.shape = cylinder;

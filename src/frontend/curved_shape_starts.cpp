@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace quadric_slam {
 
@@ -113,19 +114,32 @@ PrimitiveShape coneFromNormals(const std::vector<Eigen::Vector3d>& points,
   return cone;
 }
 
+namespace {
+
+// A cylinder's axis from its normals, which are all perpendicular to it: the least-variance
+// direction of the (uncentred) normals. None when the eigen-decomposition fails.
+std::optional<Eigen::Vector3d> axisFromNormals(const std::vector<Eigen::Vector3d>& normals) {
+  Eigen::Matrix3d N = Eigen::Matrix3d::Zero();
+  for (const auto& n : normals)
+    N += n * n.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(N);
+  if (eig.info() != Eigen::Success)
+    return std::nullopt;
+  return Eigen::Vector3d(eig.eigenvectors().col(0));
+}
+
+}  // namespace
+
 PrimitiveShape cylinderFromNormals(const std::vector<Eigen::Vector3d>& points,
                                    const std::vector<Eigen::Vector3d>& normals, double curvature) {
   PrimitiveShape cylinder =
       PrimitiveShape::cylinder(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 0);
   if (points.size() < 10 || points.size() != normals.size() || !(curvature > 0))
     return cylinder;
-  Eigen::Matrix3d N = Eigen::Matrix3d::Zero();
-  for (const auto& n : normals)
-    N += n * n.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(N);
-  if (eig.info() != Eigen::Success)
+  const std::optional<Eigen::Vector3d> found = axisFromNormals(normals);
+  if (!found)
     return cylinder;
-  const Eigen::Vector3d axis = eig.eigenvectors().col(0);
+  const Eigen::Vector3d axis = *found;
   const double radius = 1.0 / curvature;
   double best_scatter = std::numeric_limits<double>::max();
   for (const double sign : {-1.0, 1.0}) {
@@ -152,17 +166,15 @@ double cylinderCurvatureFromNormals(const std::vector<Eigen::Vector3d>& points,
                                     const std::vector<Eigen::Vector3d>& normals) {
   if (points.size() < 10 || points.size() != normals.size())
     return 0.0;
-  Eigen::Matrix3d N = Eigen::Matrix3d::Zero();
+  const std::optional<Eigen::Vector3d> found = axisFromNormals(normals);
+  if (!found)
+    return 0.0;
+  const Eigen::Vector3d axis = *found;
   Eigen::Vector3d mean_point = Eigen::Vector3d::Zero(), mean_normal = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < points.size(); ++i) {
-    N += normals[i] * normals[i].transpose();
     mean_point += points[i];
     mean_normal += normals[i];
   }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(N);
-  if (eig.info() != Eigen::Success)
-    return 0.0;
-  const Eigen::Vector3d axis = eig.eigenvectors().col(0);
   const double n = static_cast<double>(points.size());
   mean_point /= n;
   mean_normal /= n;
