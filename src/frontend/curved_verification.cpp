@@ -31,7 +31,8 @@ bool plausibleShape(const PrimitiveShape& s, const QuadricSegmenter::Params& p) 
 }
 
 std::vector<int> assignLargestComponent(const SegmentationFrame& frame, const PrimitiveShape& shape,
-                                        const ImageRoi& roi, const QuadricSegmenter::Params& p) {
+                                        const ImageRoi& roi, const QuadricSegmenter::Params& p,
+                                        std::vector<int>* eligible) {
   const double cos_angle = std::cos(p.curved_max_normal_angle);
   const int x0 = roi.x_offset, y0 = roi.y_offset, w = roi.width, h = roi.height;
   std::vector<std::uint8_t> candidate(static_cast<std::size_t>(w) * h, 0);
@@ -48,6 +49,8 @@ std::vector<int> assignLargestComponent(const SegmentationFrame& frame, const Pr
       if (std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle)
         continue;
       candidate[y * w + x] = 1;
+      if (eligible != nullptr)
+        eligible->push_back(i);
     }
   }
   std::vector<int> best, component, stack;
@@ -188,10 +191,12 @@ bool explainsDepthsBetter(const GeneralQuadricFit& general, const PrimitiveShape
 // shapes' re-assignment of the free pixels near it (in the candidate's roi) and a refinement of
 // its 9 minimal parameters on them. None when the fit is no plausible ellipsoid, the refinement
 // fails or leaves the plausible sizes, the support is too small, or the RMS exceeds the curved
-// shapes' limit (max_rms_factor). *indices receives the support.
+// shapes' limit (max_rms_factor). *indices receives the support; *eligible the pixels the
+// re-assignments found fitting (assignLargestComponent).
 std::optional<ShapeRefiner::Result> detectEllipsoid(
     const SegmentationFrame& frame, const GeneralQuadricFit& general, const ImageRoi& roi,
-    const QuadricSegmenter::Params& p, const ShapeRefiner& refiner, std::vector<int>* indices) {
+    const QuadricSegmenter::Params& p, const ShapeRefiner& refiner, std::vector<int>* indices,
+    std::vector<int>* eligible) {
   const std::optional<PrimitiveShape> start =
       ellipsoidCandidate(general, p.min_sphere_radius, p.max_sphere_radius);
   if (!start)
@@ -199,7 +204,7 @@ std::optional<ShapeRefiner::Result> detectEllipsoid(
   ShapeRefiner::Result fit;
   fit.shape = *start;
   for (int pass = 0; pass < 2; ++pass) {
-    *indices = assignLargestComponent(frame, fit.shape, roi, p);
+    *indices = assignLargestComponent(frame, fit.shape, roi, p, eligible);
     if (static_cast<int>(indices->size()) < p.min_curved_points)
       return std::nullopt;
     fit = refiner.refine(fit.shape, pointsOf(frame.cloud, *indices));
@@ -214,15 +219,16 @@ std::optional<ShapeRefiner::Result> detectEllipsoid(
   return fit;
 }
 
-// What verifying one candidate decided, and the box of pixels whose used flags the decision read
-// (the candidate's own samples, the windows searched for its support): the decision stays the same
-// as long as no pixel inside that box is taken by another detection.
+// What verifying one candidate decided, and the pixels whose used flags the decision depends on:
+// the candidate's own samples, and the pixels its re-assignments found fitting (a pixel that did
+// not fit the shape stays out of the support whether it is free or not). The decision stays the
+// same as long as no other detection takes one of them.
 struct CandidateVerdict {
   bool decided = false;  // false: not verified yet (or its speculative verification threw)
   bool accepted = false;
   std::vector<int> indices;
   ShapeRefiner::Result fit;
-  ImageRoi read_box;
+  std::vector<int> read_pixels;
 };
 
 CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
@@ -244,7 +250,7 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
     support.push_back(candidates.points[k]);
     pixels.push_back(candidates.pixels[k]);
   }
-  verdict.read_box = roiOf(all_pixels, width);
+  verdict.read_pixels = all_pixels;
   if (static_cast<int>(support.size()) < p.cgal_min_points)
     return verdict;
   PrimitiveShape shape = candidate.shape;
@@ -261,14 +267,13 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
   };
   ShapeRefiner::Result fit = refine(shape, support);
   const ImageRoi roi = grown(roiOf(pixels, width), 4 * p.cgal_stride, width, height);
-  verdict.read_box = unite(verdict.read_box, roi);
 
   std::vector<int> indices;
   std::vector<Eigen::Vector3d> points;  // those of indices
   for (int pass = 0; pass < 2; ++pass) {
     if (!plausibleShape(fit.shape, p))
       break;
-    indices = assignLargestComponent(frame, fit.shape, roi, p);
+    indices = assignLargestComponent(frame, fit.shape, roi, p, &verdict.read_pixels);
     if (static_cast<int>(indices.size()) < p.min_curved_points) {
       indices.clear();
       break;
@@ -320,9 +325,8 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
       std::vector<int> general_indices;
       const ImageRoi ellipsoid_roi =
           unite(roi, grown(roiOf(indices, width), 4 * p.cgal_stride, width, height));
-      verdict.read_box = unite(verdict.read_box, ellipsoid_roi);
-      const std::optional<ShapeRefiner::Result> ellipsoid =
-          detectEllipsoid(frame, general, ellipsoid_roi, p, refiner, &general_indices);
+      const std::optional<ShapeRefiner::Result> ellipsoid = detectEllipsoid(
+          frame, general, ellipsoid_roi, p, refiner, &general_indices, &verdict.read_pixels);
       if (ellipsoid) {
         verdict.accepted = true;
         verdict.indices = std::move(general_indices);
@@ -340,11 +344,6 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
   return verdict;
 }
 
-bool intersects(const ImageRoi& a, const ImageRoi& b) {
-  return a.x_offset < b.x_offset + b.width && b.x_offset < a.x_offset + a.width &&
-         a.y_offset < b.y_offset + b.height && b.y_offset < a.y_offset + a.height;
-}
-
 }  // namespace
 
 int verifyCurvedCandidates(const SegmentationFrame& frame, const CurvedCandidates& candidates,
@@ -357,8 +356,9 @@ int verifyCurvedCandidates(const SegmentationFrame& frame, const CurvedCandidate
   const int n = static_cast<int>(curved.size());
   // The verdicts depend on each other only through the pixels that accepted candidates take. All
   // are first verified in parallel against the free pixels as they are before this stage; then,
-  // in order, a verdict is kept when no pixel taken since lies inside the box it read, and
-  // verified again otherwise. The result is the sequential one, whatever the number of threads.
+  // in order, a verdict is kept when no pixel it depends on (CandidateVerdict::read_pixels) was
+  // taken since, and verified again otherwise. The result is the sequential one, whatever the
+  // number of threads.
   std::vector<CandidateVerdict> verdicts(n);
   if (p.threads > 1 && n > 1) {
     forEachTask(
@@ -367,35 +367,23 @@ int verifyCurvedCandidates(const SegmentationFrame& frame, const CurvedCandidate
         // Left undecided: verified again in order below, where it may throw.
         [&](int k, std::exception_ptr) { verdicts[k] = CandidateVerdict(); });
   }
-  struct Taken {
-    ImageRoi box;
-    std::vector<int> pixels;
-  };
-  std::vector<Taken> taken;
-  const auto touchesTaken = [&](const ImageRoi& box) {
-    for (const Taken& t : taken) {
-      if (!intersects(t.box, box))
-        continue;
-      for (int i : t.pixels) {
-        const int u = i % frame.width, v = i / frame.width;
-        if (u >= box.x_offset && u < box.x_offset + box.width && v >= box.y_offset &&
-            v < box.y_offset + box.height)
-          return true;
-      }
-    }
-    return false;
+  std::vector<std::uint8_t> taken_here(frame.used.size(), 0);  // taken by this stage's detections
+  const auto dependsOnTaken = [&](const CandidateVerdict& verdict) {
+    return std::any_of(verdict.read_pixels.begin(), verdict.read_pixels.end(),
+                       [&](int i) { return taken_here[i] != 0; });
   };
   int verified_again = 0;
   for (int k = 0; k < n; ++k) {
     CandidateVerdict verdict = std::move(verdicts[k]);
-    const bool stale = verdict.decided && touchesTaken(verdict.read_box);
+    const bool stale = verdict.decided && dependsOnTaken(verdict);
     verified_again += stale;
     if (!verdict.decided || stale)
       verdict = verifyCandidate(frame, *curved[k], candidates, p, refiner);
     if (!verdict.accepted)
       continue;
     accept(verdict.indices, verdict.fit);
-    taken.push_back(Taken{roiOf(verdict.indices, frame.width), std::move(verdict.indices)});
+    for (int i : verdict.indices)
+      taken_here[i] = 1;
   }
   return verified_again;
 }

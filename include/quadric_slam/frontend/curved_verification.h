@@ -22,9 +22,12 @@ bool plausibleShape(const PrimitiveShape& s, const QuadricSegmenter::Params& p);
 
 // Pixels of the frame's free points inside roi that lie within the distance threshold of shape
 // and whose normal agrees; the largest 4-connected component of them, with the large components on
-// the surface's other face.
+// the surface's other face. When eligible is given, every pixel that passed that test (in any
+// component) is appended to it: the result depends on the frame's used flags through those pixels
+// only, so it stays the same while none of them is taken.
 std::vector<int> assignLargestComponent(const SegmentationFrame& frame, const PrimitiveShape& shape,
-                                        const ImageRoi& roi, const QuadricSegmenter::Params& p);
+                                        const ImageRoi& roi, const QuadricSegmenter::Params& p,
+                                        std::vector<int>* eligible = nullptr);
 
 // Moves a curved shape's origin to the foot of the supporting points' centroid on its axis (the
 // cylinder's point is free along the axis) so that extents are centred. A general quadric is put
@@ -39,8 +42,9 @@ using AcceptDetection =
 
 // Verifies the candidates in order (biggest first), calling accept for each one kept. With
 // p.threads > 1 the verdicts are first reached in parallel against the free pixels before this
-// stage; one whose read pixels an earlier kept candidate took is verified again in order, so the
-// result is the sequential one. Returns how many were verified again.
+// stage; one that an earlier kept candidate could have changed (it took one of the candidate's
+// samples, or a pixel that fitted the candidate's shape in one of its assignments) is verified
+// again in order, so the result is the sequential one. Returns how many were verified again.
 int verifyCurvedCandidates(const SegmentationFrame& frame, const CurvedCandidates& candidates,
                            const QuadricSegmenter::Params& p, const ShapeRefiner& refiner,
                            const AcceptDetection& accept);
