@@ -239,18 +239,17 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
   const int width = frame.width, height = frame.height;
   CandidateVerdict verdict;
   verdict.decided = true;
-  // All of the candidate's pixels make the box the verdict read; the free ones are its support.
-  std::vector<int> all_pixels, pixels;
+  // The verdict depends on all of the candidate's samples; the free ones are its support.
+  std::vector<int> pixels;
   std::vector<Eigen::Vector3d> support;
-  all_pixels.reserve(candidate.indices.size());
+  verdict.read_pixels.reserve(candidate.indices.size());
   for (int k : candidate.indices) {
-    all_pixels.push_back(candidates.pixels[k]);
+    verdict.read_pixels.push_back(candidates.pixels[k]);
     if (frame.used[candidates.pixels[k]])
       continue;
     support.push_back(candidates.points[k]);
     pixels.push_back(candidates.pixels[k]);
   }
-  verdict.read_pixels = all_pixels;
   if (static_cast<int>(support.size()) < p.cgal_min_points)
     return verdict;
   PrimitiveShape shape = candidate.shape;
