@@ -24,16 +24,19 @@ QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d) 
   return c;
 }
 
-pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNormal>& cloud, int d,
-                                            int threads) {
-  pcl::PointCloud<pcl::PointNormal> grid(cloud.width / d, cloud.height / d);
+pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNormal>& cloud, int d) {
+  // Each point written once: sizing the cloud first would construct every point (a pass over the
+  // grid's memory), and the copy is bound by reading the full cloud (a second thread measured no
+  // faster).
+  pcl::PointCloud<pcl::PointNormal> grid;
+  const std::uint32_t width = cloud.width / d, height = cloud.height / d;
+  grid.points.reserve(static_cast<std::size_t>(width) * height);
+  for (std::uint32_t r = 0; r < height; ++r)
+    for (std::uint32_t c = 0; c < width; ++c)
+      grid.points.push_back(cloud(c * d, r * d));
+  grid.width = width;
+  grid.height = height;
   grid.is_dense = false;
-  // A copy bound by reading the full cloud: rows split over the threads.
-  forEachChunk(static_cast<int>(grid.height), threads, [&](int, int row_begin, int row_end) {
-    for (int r = row_begin; r < row_end; ++r)
-      for (std::uint32_t c = 0; c < grid.width; ++c)
-        grid(c, r) = cloud(c * d, r * d);
-  });
   return grid;
 }
 

@@ -271,7 +271,7 @@ Segmentation QuadricSegmenter::segmentWithNormals(
       cloud.height < static_cast<std::uint32_t>(4 * d))
     return segmentGrid(cloud, params_);
   const auto start = std::chrono::steady_clock::now();
-  const pcl::PointCloud<pcl::PointNormal> grid = decimated(cloud, d, params_.threads);
+  const pcl::PointCloud<pcl::PointNormal> grid = decimated(cloud, d);
   const double decimate_ms = msSince(start);
   Segmentation coarse = segmentGrid(grid, coarseParams(params_, d));
   const auto upsample_start = std::chrono::steady_clock::now();

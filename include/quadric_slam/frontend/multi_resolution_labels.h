@@ -15,10 +15,8 @@ namespace quadric_slam {
 // The parameters of a grid decimated by d: counts of points scale with 1 / d^2, strides with 1 / d.
 QuadricSegmenter::Params coarseParams(const QuadricSegmenter::Params& p, int d);
 
-// Every d-th point of an organized cloud in u and v ((width / d) x (height / d)), rows copied on up
-// to `threads` threads.
-pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNormal>& cloud, int d,
-                                            int threads = 1);
+// Every d-th point of an organized cloud in u and v ((width / d) x (height / d)).
+pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNormal>& cloud, int d);
 
 // Full-resolution labels from a segmentation of the grid decimated by d: each valid pixel takes
 // the label of a neighbouring coarse sample whose surface it fits (distance threshold and normal
