@@ -1,9 +1,9 @@
 #include "quadric_slam/frontend/plane_cells.h"
 
-#include <algorithm>
-#include <cmath>
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "quadric_slam/frontend/grid_flood.h"
@@ -101,7 +101,10 @@ Cell fitCell(const pcl::PointCloud<pcl::PointNormal>& cloud, const std::vector<s
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
   const int u1 = std::min(width, u0 + size), v1 = std::min(height, v0 + size);
   Cell cell;
+  // First the cheap tests, on the depths alone: no depth jump inside, enough points, far enough.
+  // Most cells of a near scene stop here, before the moments are summed.
   double sum_z = 0;
+  int depths = 0;
   for (int v = v0; v < v1; ++v) {
     for (int u = u0; u < u1; ++u) {
       const int i = v * width + u;
@@ -116,18 +119,24 @@ Cell fitCell(const pcl::PointCloud<pcl::PointNormal>& cloud, const std::vector<s
           continue;
         const double step = std::abs(cloud.points[j].z - z);
         if (step > params.max_depth_jump_factor * z &&
-            step > kJumpSigmas * kinectDepthSigma(z, params.noise_scale,
-                                                  params.quantisation_factor))
+            step >
+                kJumpSigmas * kinectDepthSigma(z, params.noise_scale, params.quantisation_factor))
           return cell;
       }
-      cell.moments.add(pointOf(cloud.points[i]));
       sum_z += z;
+      ++depths;
     }
   }
   const int area = (u1 - u0) * (v1 - v0);
-  if (cell.moments.count < std::max(6, area / 2) ||
-      sum_z < params.cell_min_depth * cell.moments.count)
+  if (depths < std::max(6, area / 2) || sum_z < params.cell_min_depth * depths)
     return cell;
+  for (int v = v0; v < v1; ++v) {
+    for (int u = u0; u < u1; ++u) {
+      const int i = v * width + u;
+      if (valid[i] && !used[i])
+        cell.moments.add(pointOf(cloud.points[i]));
+    }
+  }
   // The noise at the cell's mean depth (a cell spans little depth unless seen at a grazing angle,
   // and such cells are not planar below): of the depths, and of the inverse depths (sigma / z^2).
   const double mean_z = sum_z / cell.moments.count;
@@ -144,10 +153,8 @@ Cell fitCell(const pcl::PointCloud<pcl::PointNormal>& cloud, const std::vector<s
   // direction varies with theta's component across theta, scaled by 1 / |theta|.
   const Eigen::Matrix3d theta_covariance =
       w_variance * cell.moments.xtx.inverse() * (count / independent);
-  const Eigen::Matrix3d across =
-      Eigen::Matrix3d::Identity() - fit.normal * fit.normal.transpose();
-  cell.normal_variance =
-      (across * theta_covariance * across).trace() / fit.theta.squaredNorm();
+  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - fit.normal * fit.normal.transpose();
+  cell.normal_variance = (across * theta_covariance * across).trace() / fit.theta.squaredNorm();
   cell.centroid_variance = variance / independent;
   cell.flatness = std::sqrt(fit.residual_variance / w_variance);
   // Seen at a grazing angle the sensor smears depth along the ray (and a curved surface's
@@ -240,8 +247,9 @@ std::vector<PlaneRegionGrower::Region> growPlaneCells(
             region.indices.push_back(i);
         }
     }
-    const bool accepted = static_cast<int>(region.indices.size()) >= min_points &&
-                          patchCurvature(cloud, region.indices, plane.normal) <= params.max_curvature;
+    const bool accepted =
+        static_cast<int>(region.indices.size()) >= min_points &&
+        patchCurvature(cloud, region.indices, plane.normal) <= params.max_curvature;
     for (int c : queue)
       state[c] = accepted ? 3 : 2;
     if (!accepted)
