@@ -5,9 +5,29 @@
 #include <cstdint>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 #include "quadric_slam/frontend/plane_region_grower.h"
 
 namespace quadric_slam {
+
+namespace {
+
+// Calls fn(index) for each of the indices in order, with the cloud's point a few indices ahead
+// requested from memory meanwhile: the rim's pixels are scattered over the 15 MB cloud, and
+// reading them one at a time waited on memory for most of the stage.
+template <typename Fn>
+void forEachPoint(const pcl::PointCloud<pcl::PointNormal>& cloud, const std::vector<int>& indices,
+                  Fn fn) {
+  constexpr std::size_t kAhead = 16;
+  for (std::size_t k = 0; k < indices.size(); ++k) {
+    if (k + kAhead < indices.size())
+      __builtin_prefetch(&cloud.points[indices[k + kAhead]]);
+    fn(indices[k]);
+  }
+}
+
+}  // namespace
 
 void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
                             const BoundaryCompletion& settings, Segmentation& segmentation) {
@@ -44,43 +64,34 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
     }
   };
   std::vector<std::uint8_t> queued(cloud.size(), 0);
-  // The first front: candidates next to a labelled pixel, found with a 3x3 dilation of the label
-  // mask done as a horizontal then a vertical pass (a few operations per pixel).
-  std::vector<std::uint8_t> near_row(cloud.size(), 0);  // a label within one pixel in the row
-  for (int v = 0; v < height; ++v) {
-    const std::uint16_t* row = labels.ptr<std::uint16_t>(v);
-    std::uint8_t* out = &near_row[static_cast<std::size_t>(v) * width];
-    for (int u = 0; u < width; ++u) {
-      if (owner(row[u]) == 0)
-        continue;
-      out[u] = 1;
-      if (u > 0)
-        out[u - 1] = 1;
-      if (u + 1 < width)
-        out[u + 1] = 1;
-    }
-  }
+  // The first front: candidates next to a labelled pixel, found with a 3x3 dilation of the mask of
+  // the labelled pixels (OpenCV's vectorised mask operations: a few hundredths of a millisecond
+  // on a VGA frame, where a pixel-by-pixel scan took most of a millisecond). The cloud is read
+  // only there.
+  cv::Mat labelled, near_label;
+  cv::inRange(labels, cv::Scalar(1), cv::Scalar(n), labelled);
+  cv::dilate(labelled, near_label, cv::Mat::ones(3, 3, CV_8U));
+  near_label.setTo(0, labels != 0);
   // A candidate keeps its point: the ring reads it again only after the whole image was scanned,
   // when the cloud's memory there has left the cache.
   struct Candidate {
     int index;
     Eigen::Vector3f point;
   };
-  std::vector<Candidate> front;
+  std::vector<int> near_pixels;
   for (int v = 0; v < height; ++v) {
-    const std::uint16_t* row = labels.ptr<std::uint16_t>(v);
-    const std::uint8_t* above = &near_row[static_cast<std::size_t>(std::max(0, v - 1)) * width];
-    const std::uint8_t* here = &near_row[static_cast<std::size_t>(v) * width];
-    const std::uint8_t* below =
-        &near_row[static_cast<std::size_t>(std::min(height - 1, v + 1)) * width];
-    for (int u = 0; u < width; ++u) {
-      const int index = v * width + u;
-      if (row[u] == 0 && (above[u] | here[u] | below[u]) != 0 && mayJoin(cloud.points[index])) {
-        queued[index] = 1;
-        front.push_back({index, cloud.points[index].getVector3fMap()});
-      }
-    }
+    const std::uint8_t* near = near_label.ptr<std::uint8_t>(v);
+    for (int u = 0; u < width; ++u)
+      if (near[u] != 0)
+        near_pixels.push_back(v * width + u);
   }
+  std::vector<Candidate> front;
+  forEachPoint(cloud, near_pixels, [&](int index) {
+    if (mayJoin(cloud.points[index])) {
+      queued[index] = 1;
+      front.push_back({index, cloud.points[index].getVector3fMap()});
+    }
+  });
   for (int ring = 0; ring < settings.rings && !front.empty(); ++ring) {
     // Each ring reads the labels of the previous one only, so growth is one pixel per ring.
     std::vector<std::pair<Candidate, std::uint16_t>> joined;
@@ -128,15 +139,23 @@ void completeBoundaryLabels(const pcl::PointCloud<pcl::PointNormal>& cloud,
       roi.width = x1 - roi.x_offset + 1;
       roi.height = y1 - roi.y_offset + 1;
     }
+    // The next front: the free neighbours of the joined pixels, each listed once (marked while
+    // listed), then read from the cloud; those that may not join are unmarked again.
+    std::vector<int> neighbours;
     for (const auto& [candidate, label] : joined) {
       forEachNeighbour(candidate.index, [&](int neighbour, int nu, int nv) {
-        if (!queued[neighbour] && labels.at<std::uint16_t>(nv, nu) == 0 &&
-            mayJoin(cloud.points[neighbour])) {
+        if (!queued[neighbour] && labels.at<std::uint16_t>(nv, nu) == 0) {
           queued[neighbour] = 1;
-          next_front.push_back({neighbour, cloud.points[neighbour].getVector3fMap()});
+          neighbours.push_back(neighbour);
         }
       });
     }
+    forEachPoint(cloud, neighbours, [&](int index) {
+      if (mayJoin(cloud.points[index]))
+        next_front.push_back({index, cloud.points[index].getVector3fMap()});
+      else
+        queued[index] = 0;
+    });
     front.swap(next_front);
   }
 }
