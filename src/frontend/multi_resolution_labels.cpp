@@ -46,12 +46,6 @@ namespace {
 // samples joins it without normal agreement (the 3-sigma band of the fit's own residuals).
 constexpr double kNoiseGate = 3.0;
 
-bool validPoint(const pcl::PointNormal& q, const QuadricSegmenter::Params& p) {
-  return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) &&
-         std::isfinite(q.normal_x) && std::isfinite(q.normal_y) && std::isfinite(q.normal_z) &&
-         q.z >= p.min_range && q.z <= p.max_range;
-}
-
 }  // namespace
 
 Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
@@ -61,52 +55,59 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
   result.labels = cv::Mat::zeros(height, width, CV_16UC1);
   const int n = static_cast<int>(coarse.detections.size());
-  std::vector<Eigen::Isometry3d> T_quadric_camera(n);
-  std::vector<double> cos_angle(n), noise_gate(n);
-  for (int k = 0; k < n; ++k) {
-    T_quadric_camera[k] = coarse.detections[k].shape.quadric().pose().inverse();
-    cos_angle[k] = std::cos(coarse.detections[k].shape.quadric_class == QuadricClass::kPlane
-                                ? p.planes.max_normal_angle
-                                : p.curved_max_normal_angle);
-    noise_gate[k] = std::max(1e-3, kNoiseGate * coarse.detections[k].fit_rms);
+  // What a pixel's test reads of each detection, in one place (read for every pixel).
+  struct Target {
+    const PrimitiveShape* shape;
+    Eigen::Isometry3d T_quadric_camera;
+    double cos_angle, noise_gate;
+  };
+  std::vector<Target> targets;
+  targets.reserve(n);
+  for (const QuadricDetection& detection : coarse.detections) {
+    const bool plane = detection.shape.quadric_class == QuadricClass::kPlane;
+    targets.push_back({&detection.shape, detection.shape.quadric().pose().inverse(),
+                       std::cos(plane ? p.planes.max_normal_angle : p.curved_max_normal_angle),
+                       std::max(1e-3, kNoiseGate * detection.fit_rms)});
   }
   // Per-chunk tallies of the labelled points (rows split over threads), merged afterwards.
   struct Tally {
-    std::vector<int> count;
-    std::vector<double> sum_sq;  // squared distances of the labelled points to their surface
-    std::vector<Eigen::Vector3d> lo, hi;
-    std::vector<ImageRoi> box;  // x, y min; width, height = max
+    int count = 0;
+    double sum_sq = 0.0;  // squared distances of the labelled points to their surface
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+    Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::max());
+    int u_min = std::numeric_limits<int>::max(), v_min = std::numeric_limits<int>::max();
+    int u_max = -1, v_max = -1;
   };
   // Rows are split over the threads by blocks of d rows: the d x d full-resolution pixels of a
   // block share their four neighbouring coarse samples, read once.
   const int block_rows = (height + d - 1) / d;
   const int threads = std::max(1, std::min(p.threads, block_rows));
-  std::vector<Tally> tallies(threads);
+  std::vector<std::vector<Tally>> tallies(threads);
   const int cw = coarse.labels.cols, ch = coarse.labels.rows;
+  // Locals, so that the pixel loop keeps them in registers.
+  const double min_range = p.min_range, max_range = p.max_range;
+  const double distance_factor = p.planes.distance_factor, min_distance = p.planes.min_distance;
   forEachChunk(block_rows, threads, [&](int chunk, int block_row_begin, int block_row_end) {
-    Tally& tally = tallies[chunk];
-    tally.count.assign(n, 0);
-    tally.sum_sq.assign(n, 0.0);
-    tally.lo.assign(n, Eigen::Vector3d::Constant(std::numeric_limits<double>::max()));
-    tally.hi.assign(n, Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
-    tally.box.assign(n, ImageRoi{width, height, -1, -1});
+    std::vector<Tally>& tally = tallies[chunk];
+    tally.assign(n, Tally());
     // Labels pixel (u, v) with the best of the distinct candidate labels, if any fits.
     const auto labelPixel = [&](int u, int v, const std::uint16_t* labels, int distinct,
                                 bool single_surface, std::uint16_t* label_row) {
       const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
-      if (!validPoint(q, p))
+      if (!(q.z >= min_range && q.z <= max_range) || !std::isfinite(q.x) || !std::isfinite(q.y) ||
+          !std::isfinite(q.normal_x) || !std::isfinite(q.normal_y) || !std::isfinite(q.normal_z))
         return;
       const Eigen::Vector3d point = pointOf(q);
       int best = 0;
-      double best_distance = depthThreshold(q.z, p.planes.distance_factor, p.planes.min_distance);
+      double best_distance = depthThreshold(q.z, distance_factor, min_distance);
       for (int c = 0; c < distinct; ++c) {
         const int label = labels[c];
-        const PrimitiveShape& shape = coarse.detections[label - 1].shape;
-        const double distance = std::abs(shape.distance(point));
+        const Target& target = targets[label - 1];
+        const double distance = std::abs(target.shape->distance(point));
         if (distance >= best_distance)
           continue;
-        if ((!single_surface || distance > noise_gate[label - 1]) &&
-            std::abs(shape.normalAt(point).dot(normalOf(q))) < cos_angle[label - 1])
+        if ((!single_surface || distance > target.noise_gate) &&
+            std::abs(target.shape->normalAt(point).dot(normalOf(q))) < target.cos_angle)
           continue;
         best = label;
         best_distance = distance;
@@ -114,17 +115,16 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
       if (best == 0)
         return;
       label_row[u] = static_cast<std::uint16_t>(best);
-      const int k = best - 1;
-      ++tally.count[k];
-      tally.sum_sq[k] += best_distance * best_distance;
-      const Eigen::Vector3d local = T_quadric_camera[k] * point;
-      tally.lo[k] = tally.lo[k].cwiseMin(local);
-      tally.hi[k] = tally.hi[k].cwiseMax(local);
-      ImageRoi& box = tally.box[k];
-      box.x_offset = std::min(box.x_offset, u);
-      box.y_offset = std::min(box.y_offset, v);
-      box.width = std::max(box.width, u);
-      box.height = std::max(box.height, v);
+      Tally& t = tally[best - 1];
+      ++t.count;
+      t.sum_sq += best_distance * best_distance;
+      const Eigen::Vector3d local = targets[best - 1].T_quadric_camera * point;
+      t.lo = t.lo.cwiseMin(local);
+      t.hi = t.hi.cwiseMax(local);
+      t.u_min = std::min(t.u_min, u);
+      t.v_min = std::min(t.v_min, v);
+      t.u_max = std::max(t.u_max, u);
+      t.v_max = std::max(t.v_max, v);
     };
     for (int j = block_row_begin; j < block_row_end; ++j) {
       const std::uint16_t* row0 = coarse.labels.ptr<std::uint16_t>(std::min(j, ch - 1));
@@ -162,16 +162,17 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
   std::vector<Eigen::Vector3d> hi(n,
                                   Eigen::Vector3d::Constant(-std::numeric_limits<double>::max()));
   std::vector<ImageRoi> box(n, ImageRoi{width, height, -1, -1});
-  for (const Tally& tally : tallies) {
+  for (const std::vector<Tally>& chunk_tally : tallies) {
     for (int k = 0; k < n; ++k) {
-      count[k] += tally.count[k];
-      sum_sq[k] += tally.sum_sq[k];
-      lo[k] = lo[k].cwiseMin(tally.lo[k]);
-      hi[k] = hi[k].cwiseMax(tally.hi[k]);
-      box[k].x_offset = std::min(box[k].x_offset, tally.box[k].x_offset);
-      box[k].y_offset = std::min(box[k].y_offset, tally.box[k].y_offset);
-      box[k].width = std::max(box[k].width, tally.box[k].width);
-      box[k].height = std::max(box[k].height, tally.box[k].height);
+      const Tally& t = chunk_tally[k];
+      count[k] += t.count;
+      sum_sq[k] += t.sum_sq;
+      lo[k] = lo[k].cwiseMin(t.lo);
+      hi[k] = hi[k].cwiseMax(t.hi);
+      box[k].x_offset = std::min(box[k].x_offset, t.u_min);
+      box[k].y_offset = std::min(box[k].y_offset, t.v_min);
+      box[k].width = std::max(box[k].width, t.u_max);
+      box[k].height = std::max(box[k].height, t.v_max);
     }
   }
   // Keep the detections with support, renumbered 1..m.
