@@ -12,6 +12,7 @@
 #include "quadric_slam/frontend/parallel_chunks.h"
 #include "quadric_slam/frontend/plane_region_grower.h"
 #include "quadric_slam/frontend/ray_residual.h"
+#include "quadric_slam/frontend/silhouette_taper.h"
 
 namespace quadric_slam {
 
@@ -287,7 +288,9 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
       normals.reserve(indices.size());
       for (int i : indices)
         normals.push_back(normalOf(cloud.points[i]).normalized());
-      fit = selectCurvedModel(fit, points, normals, p, refiner);
+      fit =
+          selectCurvedModel(fit, points, normals,
+                            cutOutline(frame, indices, p.planes.max_depth_jump_factor), p, refiner);
     }
   }
   if (indices.empty() || !plausibleShape(fit.shape, p))

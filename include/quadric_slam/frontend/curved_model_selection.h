@@ -15,6 +15,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -29,11 +30,13 @@ constexpr int kScreeningPoints = 250;
 
 // The best of fit (refined on points, class sphere, cylinder or cone) and the alternatives;
 // normals are the measured unit normals of the points (the cone start from normals and the
-// cones' normal agreement use them).
+// cones' normal agreement use them); cut flags the points on cut outlines (empty, or one per
+// point: silhouette_taper.h).
 // Planes and general quadrics are returned unchanged.
 ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& fit,
                                        const std::vector<Eigen::Vector3d>& points,
                                        const std::vector<Eigen::Vector3d>& normals,
+                                       const std::vector<std::uint8_t>& cut,
                                        const QuadricSegmenter::Params& p,
                                        const ShapeRefiner& refiner);
 

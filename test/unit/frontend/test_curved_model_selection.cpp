@@ -56,7 +56,7 @@ qs::QuadricSegmenter::Params params() {
 qs::ShapeRefiner::Result selected(const PrimitiveShape& start, const Samples& s) {
   const qs::ShapeRefiner refiner;
   const qs::ShapeRefiner::Result fit = refiner.refine(start, s.points);
-  return qs::selectCurvedModel(fit, s.points, s.normals, params(), refiner);
+  return qs::selectCurvedModel(fit, s.points, s.normals, {}, params(), refiner);
 }
 
 }  // namespace
@@ -123,7 +123,7 @@ TEST(CurvedModelSelection, CylinderFittedAsAWideConeBecomesCylinder) {
   ASSERT_LT(cone.shape.size, params().max_cone_half_angle) << "a plausible cone";
   std::printf("the wide cone: half angle %.3f, RMS %.4f m\n", cone.shape.size, cone.rms);
   const qs::ShapeRefiner::Result result =
-      qs::selectCurvedModel(cone, s.points, s.normals, params(), refiner);
+      qs::selectCurvedModel(cone, s.points, s.normals, {}, params(), refiner);
   ASSERT_EQ(result.shape.quadric_class, QuadricClass::kCylinder);
   EXPECT_NEAR(result.shape.size, radius, 0.002);
 }
