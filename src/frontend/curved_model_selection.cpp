@@ -98,8 +98,7 @@ SilhouetteTaper outlineAlong(const PrimitiveShape& cylinder,
 bool coneMatchesTaper(const PrimitiveShape& cone, const PrimitiveShape& cylinder,
                       const SilhouetteTaper& taper) {
   if (taper.bins >= kMinTaperBins)
-    return taper.significant(kMinConeTaper) &&
-           slopeMatches(taper.slope, taper.slope_sigma, predictedTaper(cone, cylinder.direction));
+    return slopeMatches(taper.slope, taper.slope_sigma, predictedTaper(cone, cylinder.direction));
   const int side = loneEdge(taper);
   if (side < 0)
     return false;

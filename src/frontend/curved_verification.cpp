@@ -288,9 +288,13 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
       normals.reserve(indices.size());
       for (int i : indices)
         normals.push_back(normalOf(cloud.points[i]).normalized());
-      fit =
-          selectCurvedModel(fit, points, normals,
-                            cutOutline(frame, indices, p.planes.max_depth_jump_factor), p, refiner);
+      // The outline's cut pixels matter only to a cylinder or a cone (the taper).
+      const bool tapered = fit.shape.quadric_class == QuadricClass::kCylinder ||
+                           fit.shape.quadric_class == QuadricClass::kCone;
+      fit = selectCurvedModel(fit, points, normals,
+                              tapered ? cutOutline(frame, indices, p.planes.max_depth_jump_factor)
+                                      : std::vector<std::uint8_t>(),
+                              p, refiner);
     }
   }
   if (indices.empty() || !plausibleShape(fit.shape, p))

@@ -9,8 +9,8 @@ namespace quadric_slam {
 namespace {
 
 constexpr int kBins = 8;
-// Bins when one side of the outline is cut by an occluder somewhere: a side's uncut run may be a
-// third of the support, and its slope needs kMinTaperBins bins there.
+// Bins when one side of the outline is cut somewhere: a side's uncut run may be a third of the
+// support, and its slope needs kMinTaperBins bins there.
 constexpr int kFineBins = 16;
 constexpr int kMinPointsPerBin = 8;
 constexpr double kMinLength = 0.1;       // m
