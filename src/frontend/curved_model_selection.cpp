@@ -40,13 +40,13 @@ double correlatedGridPoints(const QuadricSegmenter::Params& p) {
 // segment's outline, cut by occluders and the segmenter's borders, says nothing.
 constexpr double kMinConeTaper = 0.09;
 
-// Whether a measured slope is a cone's predicted one: significant (above 3 sigma and
+// Whether a measured slope is a cone's predicted one: significant (significantSlope with
 // kMinConeTaper), of the same sign, 0.4 to 2 times as large. The segmenter drops a curved surface's
 // grazing edges, so the measured width is a fraction of the true one; on the generated room's cone
 // 2.6 m away the measured taper was 0.43-1.2 times the predicted.
 bool slopeMatches(double measured, double sigma, double predicted) {
-  return std::abs(measured) > 3.0 * sigma && std::abs(measured) > kMinConeTaper &&
-         predicted * measured > 0.0 && std::abs(measured) > 0.4 * std::abs(predicted) &&
+  return significantSlope(measured, sigma, kMinConeTaper) && predicted * measured > 0.0 &&
+         std::abs(measured) > 0.4 * std::abs(predicted) &&
          std::abs(measured) < 2.0 * std::abs(predicted);
 }
 

@@ -115,9 +115,12 @@ BinnedOutline binOutline(const std::vector<double>& s, const std::vector<double>
 
 }  // namespace
 
+bool significantSlope(double slope, double sigma, double min_slope) {
+  return std::abs(slope) > 3.0 * sigma && std::abs(slope) > min_slope;
+}
+
 bool SilhouetteTaper::significant(double min_slope) const {
-  return bins >= kMinTaperBins && std::abs(slope) > 3.0 * slope_sigma &&
-         std::abs(slope) > min_slope;
+  return bins >= kMinTaperBins && significantSlope(slope, slope_sigma, min_slope);
 }
 
 std::vector<std::uint8_t> cutOutline(const SegmentationFrame& frame,

@@ -49,9 +49,13 @@ struct SilhouetteTaper {
   SilhouetteEdge low_edge, high_edge;
 
   // True when the width changes along the axis beyond the measurement's noise: at least
-  // kMinTaperBins bins, |k| above 3 sigma and above min_slope.
+  // kMinTaperBins bins and significantSlope(slope, slope_sigma, min_slope).
   bool significant(double min_slope) const;
 };
+
+// Whether a measured edge or taper slope stands out of its noise: |slope| above 3 sigma and above
+// min_slope.
+bool significantSlope(double slope, double sigma, double min_slope);
 
 // Bins with enough points a taper needs.
 constexpr int kMinTaperBins = 4;
