@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -52,8 +53,7 @@ std::string truthClassName(const PrimitiveShape& shape) {
 
 void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat& truth,
                                  const cv::Mat& valid,
-                                 const std::map<int, PrimitiveShape>& truth_camera,
-                                 double max_error_range) {
+                                 const std::map<int, PrimitiveShape>& truth_camera) {
   addFrame(segmentation, truth, valid);
   std::map<int, int> detection_size;
   std::map<std::pair<int, int>, int> both;
@@ -78,13 +78,23 @@ void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat
         it->second.quadric_class != d.shape.quadric_class)
       continue;
     const Eigen::Vector3d centre = d.shape.quadric().pose() * (0.5 * (d.extent_min + d.extent_max));
-    if (centre.norm() > max_error_range)
-      continue;
     const auto [first, second] = shapeErrors(d.shape, it->second);
-    ParameterErrors& e = errors_[toString(d.shape.quadric_class)];
-    e.first.push_back(first);
-    e.second.push_back(second);
+    errors_[toString(d.shape.quadric_class)].push_back({centre.norm(), first, second});
   }
+}
+
+std::map<std::string, SegmentationScore::ParameterErrors> SegmentationScore::parameterErrors(
+    double min_range, double max_range) const {
+  std::map<std::string, ParameterErrors> out;
+  for (const auto& [name, fits] : errors_)
+    for (const FitError& fit : fits) {
+      if (fit.range < min_range || fit.range >= max_range)
+        continue;
+      ParameterErrors& e = out[name];
+      e.first.push_back(fit.first);
+      e.second.push_back(fit.second);
+    }
+  return out;
 }
 
 double SegmentationScore::median(std::vector<double> values) {
@@ -144,8 +154,7 @@ void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat
         majority_pixels = pixels;
       }
     const auto it = truth_classes_.find(majority);
-    if (majority == 0 || it == truth_classes_.end() ||
-        it->second != truthClassName(d.shape)) {
+    if (majority == 0 || it == truth_classes_.end() || it->second != truthClassName(d.shape)) {
       ++spurious_;
       if (majority != 0 && it != truth_classes_.end() && !scored(majority))
         ++spurious_unmodelled_;
@@ -177,14 +186,21 @@ std::string SegmentationScore::report() const {
       {"sphere", {"centre (m)", "radius (m)"}},
       {"cylinder", {"axis angle (deg)", "radius (m)"}},
       {"cone", {"axis angle (deg)", "half angle (deg)"}}};
-  for (const auto& [name, e] : errors_) {
-    const auto it = kNames.find(name);
-    if (it == kNames.end())
-      continue;
-    std::snprintf(line, sizeof(line), "median errors %-8s (%4zu fits): %s %.4f, %s %.4f\n",
-                  name.c_str(), e.first.size(), it->second.first, median(e.first),
-                  it->second.second, median(e.second));
-    out << line;
+  // Bands of range (m) whose errors are reported apart.
+  static const std::vector<std::pair<double, const char*>> kBands = {
+      {2.0, "0-2 m"}, {4.0, "2-4 m"}, {std::numeric_limits<double>::infinity(), "4 m+"}};
+  double lower = 0.0;
+  for (const auto& [upper, band] : kBands) {
+    for (const auto& [name, e] : parameterErrors(lower, upper)) {
+      const auto it = kNames.find(name);
+      if (it == kNames.end())
+        continue;
+      std::snprintf(line, sizeof(line), "median errors %-8s %-5s (%4zu fits): %s %.4f, %s %.4f\n",
+                    name.c_str(), band, e.first.size(), it->second.first, median(e.first),
+                    it->second.second, median(e.second));
+      out << line;
+    }
+    lower = upper;
   }
   return out.str();
 }

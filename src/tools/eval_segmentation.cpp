@@ -1,11 +1,12 @@
 // eval_segmentation: the segmenter over a synthetic sequence written by scripts/synth (TUM folder
 // with labels/<stamp>.png and quadrics_gt.yaml): per primitive with enough valid pixels, the share
 // of frames in which its class is detected on it, the spurious detections per frame, and the
-// median parameter errors per class of the detections found within --max-range of the camera
-// (truth: quadrics_gt.yaml moved into the camera frame by groundtruth.txt, T_world_camera).
+// median parameter errors of the detections found, per class and band of range from the camera
+// (0-2 m, 2-4 m, beyond; truth: quadrics_gt.yaml moved into the camera frame by groundtruth.txt,
+// T_world_camera).
 //
 //   eval_segmentation DIR [--stride K (1)] [--max-frames N (all)] [--min-pixels P (2000)]
-//                         [--max-range M (2.0)] [--config segmentation.yaml]
+//                         [--config segmentation.yaml]
 //                         [--verbose 1: per frame, the stamp and the ids of missed surfaces]
 #include <yaml-cpp/yaml.h>
 
@@ -36,12 +37,11 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help") {
     std::fprintf(stderr,
                  "usage: eval_segmentation DIR [--stride K] [--max-frames N] [--min-pixels P] "
-                 "[--max-range M] [--config segmentation.yaml]\n");
+                 "[--config segmentation.yaml] [--verbose 1]\n");
     return 2;
   }
   const std::string dir = argv[1];
   int stride = 1, max_frames = 1 << 30, min_pixels = qs::kLargeViewPixels;
-  double max_range = 2.0;
   bool verbose = false;
   qs::QuadricSegmenter::Params params;
   try {
@@ -55,8 +55,6 @@ int main(int argc, char** argv) {
         min_pixels = std::atoi(value.c_str());
       else if (arg == "--verbose")
         verbose = value == "1";
-      else if (arg == "--max-range")
-        max_range = std::atof(value.c_str());
       else if (arg == "--config")
         params = qs::loadSegmenterParams(value);
       else
@@ -112,7 +110,7 @@ int main(int argc, char** argv) {
       std::map<int, qs::PrimitiveShape> truth_camera;
       for (const auto& [id, shape] : truth_world)
         truth_camera[id] = shape.transformed(pose->second.inverse());
-      score.addFrame(segmentation, truth, valid, truth_camera, max_range);
+      score.addFrame(segmentation, truth, valid, truth_camera);
       if (verbose && !score.lastMissed().empty()) {
         std::printf("%s missed:", stamp.c_str());
         for (int id : score.lastMissed())

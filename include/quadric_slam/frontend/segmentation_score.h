@@ -29,10 +29,10 @@ class SegmentationScore {
   // The same, and the parameter errors of the detections counted as found, against the true
   // shapes in the camera frame (surface id -> shape): plane normal angle (deg) and offset (m),
   // sphere centre (m) and radius (m), cylinder axis angle (deg, as lines) and radius (m), cone axis
-  // angle (deg) and half angle (deg). Only detections whose support centre lies within
-  // max_error_range (m) of the camera count.
+  // angle (deg) and half angle (deg). Each error is kept with its range: the distance from the
+  // camera to the centre of the detection's support (the sensor's noise grows with it).
   void addFrame(const Segmentation& segmentation, const cv::Mat& truth, const cv::Mat& valid,
-                const std::map<int, PrimitiveShape>& truth_camera, double max_error_range = 2.0);
+                const std::map<int, PrimitiveShape>& truth_camera);
 
   struct Surface {
     std::string quadric_class;
@@ -51,13 +51,16 @@ class SegmentationScore {
   double spuriousPerFrameOnModelled() const {
     return frames_ ? double(spurious_ - spurious_unmodelled_) / frames_ : 0.0;
   }
-  // Per class name: the two error kinds above, one entry per found detection within range.
+  // Per class name: the two error kinds above, one entry per found detection whose range is in
+  // [min_range, max_range) (m).
   struct ParameterErrors {
     std::vector<double> first, second;  // plane angle/offset; sphere centre/radius; ...
   };
-  const std::map<std::string, ParameterErrors>& parameterErrors() const { return errors_; }
+  std::map<std::string, ParameterErrors> parameterErrors(double min_range, double max_range) const;
   // Median of a list (0 when empty).
   static double median(std::vector<double> values);
+  // Per surface its detection rate; the spurious detections; per class and band of range (0-2 m,
+  // 2-4 m, beyond 4 m) the median parameter errors.
   std::string report() const;
 
  private:
@@ -65,9 +68,12 @@ class SegmentationScore {
   int min_pixels_;
   std::map<int, Surface> surfaces_;
   int frames_ = 0, spurious_ = 0, spurious_unmodelled_ = 0;
-  std::map<std::string, int> spurious_kinds_;
-  std::map<std::string, ParameterErrors> errors_;
-  std::vector<int> last_missed_;  // "<detected class> on <surface class>" -> count
+  std::map<std::string, int> spurious_kinds_;  // "<detected class> on <surface class>" -> count
+  struct FitError {
+    double range, first, second;
+  };
+  std::map<std::string, std::vector<FitError>> errors_;  // class name -> found detections' errors
+  std::vector<int> last_missed_;
 };
 
 }  // namespace quadric_slam

@@ -40,7 +40,7 @@ inline std::filesystem::path synthTool() {
 // the segmenter on every frame; nullopt (with a test failure) when rendering or reading fails.
 inline std::optional<SegmentationScore> scoreSynthSequence(const std::string& name,
                                                            const std::string& synth_arguments,
-                                                           int min_pixels, double error_range) {
+                                                           int min_pixels) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::path(testing::TempDir()) / name;
   fs::remove_all(dir);
@@ -94,7 +94,7 @@ inline std::optional<SegmentationScore> scoreSynthSequence(const std::string& na
     std::map<int, PrimitiveShape> truth_camera;
     for (const auto& [id, shape] : truth_world)
       truth_camera[id] = shape.transformed(pose->second.inverse());
-    score.addFrame(segmenter.segment(cloud), truth, depth == depth, truth_camera, error_range);
+    score.addFrame(segmenter.segment(cloud), truth, depth == depth, truth_camera);
   }
   fs::remove_all(dir);
   return score;

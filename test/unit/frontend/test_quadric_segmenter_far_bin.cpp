@@ -23,8 +23,7 @@ TEST(QuadricSegmenterFarBin, TheDesksOpenBinIsACylinder) {
     GTEST_SKIP() << "the synth tool is not built beside this test";
   const std::string scene = std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/desk.yaml";
   const std::optional<qs::SegmentationScore> scored = qs::test::scoreSynthSequence(
-      "segmenter_far_bin", "--scene " + scene + " --seconds 30 --rate 1 --no-bag --seed 1", 2000,
-      2.0);
+      "segmenter_far_bin", "--scene " + scene + " --seconds 30 --rate 1 --no-bag --seed 1", 2000);
   ASSERT_TRUE(scored);
   std::printf("%s", scored->report().c_str());
   // The generator numbers surfaces in the scene file's order (a box gives six): the bin is 23.
