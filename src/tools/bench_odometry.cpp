@@ -57,6 +57,12 @@ double percentile(std::vector<double> v, double q) {
 int main(int argc, char** argv) {
   int frames = 150, decimation = 1, stride = 4, ref_stride = 2, levels = 3, verbose = 0;
   double noise = 0.0015;
+  if (argc % 2 == 0) {  // an option without its value, or --help
+    std::fprintf(stderr,
+                 "usage: bench_odometry [--frames N] [--decimation D] [--stride S] [--noise M] "
+                 "[--levels L] [--ref-stride R] [--verbose V]\n");
+    return 2;
+  }
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     const char* value = argv[i + 1];

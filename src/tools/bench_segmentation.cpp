@@ -214,12 +214,22 @@ void report(const char* name, const std::vector<double>& times) {
               percentile(times, 0.5), percentile(times, 0.95));
 }
 
+int usage() {
+  std::fprintf(stderr,
+               "usage: bench_segmentation [--data DIR] [--repeats N] [--synthetic N] "
+               "[--baseline-frames N] [--kitchen-every K] [--harsh N] [--config "
+               "segmentation.yaml] [--set KEY=VALUE]...\n");
+  return 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string data = QUADRIC_SLAM_SHARED_DATA_DIR;
   int repeats = 3, synthetic = 10, baseline_frames = 8, kitchen_every = 50, harsh = 10;
   qs::QuadricSegmenter::Params params;
+  if (argc % 2 == 0)  // an option without its value, or --help
+    return usage();
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string arg = argv[i], value = argv[i + 1];
     if (arg == "--data")
@@ -239,13 +249,8 @@ int main(int argc, char** argv) {
     else if (arg == "--set" && value.find('=') != std::string::npos)
       qs::setSegmenterParam(params, value.substr(0, value.find('=')),
                             std::atof(value.c_str() + value.find('=') + 1));
-    else {
-      std::fprintf(stderr,
-                   "usage: bench_segmentation [--data DIR] [--repeats N] [--synthetic N] "
-                   "[--baseline-frames N] [--kitchen-every K] [--harsh N] [--config "
-                   "segmentation.yaml] [--set KEY=VALUE]...\n");
-      return 2;
-    }
+    else
+      return usage();
   }
   const qs::NormalEstimator normals{qs::NormalEstimator::Params()};
   const qs::QuadricSegmenter segmenter(params);
