@@ -50,6 +50,25 @@ bool slopeMatches(double measured, double sigma, double predicted) {
          std::abs(measured) < 2.0 * std::abs(predicted);
 }
 
+// Whether the outline measured on both sides rules a cone out: its predicted taper is clear (over
+// twice kMinConeTaper) and the measured one is under kContradictedTaperShare of it and more than
+// kContradictionSigmas standard errors away, so the width stays about constant where the cone's
+// would change. On the generated desk, a wide cone proposed on a lying tube with its flat end cap
+// (the flare takes in the cap) predicted 0.6, and the outline measured 0.01-0.02 +- 0.005. A cone
+// proposed far too wide on a true cone 2.8 m away (1.2 rad against 0.32: 0.71 against 0.15) is
+// ruled out too; the cone the outline shows is then found from the cylinder.
+constexpr double kContradictedTaperShare = 0.25;
+constexpr double kContradictionSigmas = 5.0;
+bool outlineRulesOutCone(const PrimitiveShape& cone, const PrimitiveShape& cylinder,
+                         const SilhouetteTaper& taper) {
+  if (taper.bins < kMinTaperBins)
+    return false;
+  const double predicted = predictedTaper(cone, cylinder.direction);
+  return std::abs(predicted) > 2.0 * kMinConeTaper &&
+         std::abs(taper.slope) < kContradictedTaperShare * std::abs(predicted) &&
+         std::abs(predicted - taper.slope) > kContradictionSigmas * taper.slope_sigma;
+}
+
 // Least uncut bins of a side whose edge alone is compared with a cone's (the other side cut all
 // along): the slope of one edge also carries the error of the fitted axis's direction, which the
 // difference of two edges cancels.
@@ -188,7 +207,11 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
   const double ratio = p.cylinder_rms_ratio;
 
   // A thin cone is a cylinder when the cylinder fits almost as well, unless the cone is
-  // significantly better over all the points.
+  // significantly better over all the points. Any cone is a cylinder when its outline rules it
+  // out, however it fits: its support may hold a surface beside the cylinder that the cone bends
+  // into (a tube's flat end cap), and the cylinder's own support is found again in the second
+  // assignment.
+  bool cone_ruled_out = false;
   if (fit.shape.quadric_class == QuadricClass::kCone) {
     // From the cone's axis, and from the normals alone: a wide cone fitted to a cylinder's strip
     // has its axis far from the cylinder's, where the first start cannot find it.
@@ -199,12 +222,17 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
     if (from_normals && (!as_cylinder || from_normals->rms < as_cylinder->rms))
       as_cylinder = from_normals;
     const double cone_rms = alternatives.sampleRms(fit);
-    if (as_cylinder && as_cylinder->rms < ratio * cone_rms &&
-        !coneSignificantlyBetter(cone_rms, as_cylinder->rms, points.size(), p) &&
-        !coneMatchesTaper(fit.shape, as_cylinder->shape,
-                          outlineAlong(as_cylinder->shape, points, cut, false)))
-      if (const auto confirmed = alternatives.confirm(*as_cylinder))
-        fit = *confirmed;
+    if (as_cylinder) {
+      const SilhouetteTaper outline = outlineAlong(as_cylinder->shape, points, cut, false);
+      cone_ruled_out = outlineRulesOutCone(fit.shape, as_cylinder->shape, outline);
+      if (cone_ruled_out ||
+          (as_cylinder->rms < ratio * cone_rms &&
+           !coneSignificantlyBetter(cone_rms, as_cylinder->rms, points.size(), p) &&
+           !coneMatchesTaper(fit.shape, as_cylinder->shape, outline)))
+        if (const auto confirmed = alternatives.confirm(*as_cylinder))
+          fit = *confirmed;
+      cone_ruled_out = cone_ruled_out && fit.shape.quadric_class == QuadricClass::kCylinder;
+    }
   }
   // A cylinder is a cone when a cone, started from the cylinder or from the normals, fits clearly
   // better (by the RMS ratio, or significantly over all the points).
@@ -222,6 +250,9 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
     for (int k = 0; k < 4; ++k) {
       const auto as_cone = alternatives.screen(starts[k]);
       if (!as_cone)
+        continue;
+      // After an outline ruled a cone out, only a cone the outline shows.
+      if (cone_ruled_out && !coneMatchesTaper(as_cone->shape, fit.shape, taper))
         continue;
       // Far away the depth cannot tell them apart, the outline can: a cone that fits no worse
       // than the cylinder and whose opening the silhouette shows.
