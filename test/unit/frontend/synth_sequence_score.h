@@ -36,6 +36,24 @@ inline std::filesystem::path synthTool() {
   return std::filesystem::exists(synth) ? synth : std::filesystem::path();
 }
 
+// The synth arguments of a scene of config/scenes ("desk", "room") under the default (harsh) depth
+// model at 1 Hz for 30 s: the sequences of docs/segmentation/README.md.
+inline std::string sceneSequenceArguments(const std::string& scene, int seed) {
+  return "--scene " + std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/" + scene +
+         ".yaml --seconds 30 --rate 1 --no-bag --seed " + std::to_string(seed);
+}
+
+// Expects surface `id` to be of `quadric_class`, scored in at least min_frames frames and detected
+// in at least min_rate of them.
+inline void expectSurfaceFound(const SegmentationScore& score, int id,
+                               const std::string& quadric_class, int min_frames, double min_rate) {
+  const auto surface = score.surfaces().find(id);
+  ASSERT_NE(surface, score.surfaces().end()) << "surface " << id << " never scored";
+  ASSERT_EQ(surface->second.quadric_class, quadric_class);
+  EXPECT_GE(surface->second.frames_scored, min_frames) << "surface " << id;
+  EXPECT_GE(surface->second.rate(), min_rate) << "surface " << id;
+}
+
 // Renders `synth_arguments` (everything but --out) into a temporary folder named `name` and scores
 // the segmenter on every frame; nullopt (with a test failure) when rendering or reading fails.
 inline std::optional<SegmentationScore> scoreSynthSequence(const std::string& name,

@@ -21,17 +21,12 @@ namespace qs = quadric_slam;
 TEST(QuadricSegmenterFarBin, TheDesksOpenBinIsACylinder) {
   if (qs::test::synthTool().empty())
     GTEST_SKIP() << "the synth tool is not built beside this test";
-  const std::string scene = std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/desk.yaml";
   const std::optional<qs::SegmentationScore> scored = qs::test::scoreSynthSequence(
-      "segmenter_far_bin", "--scene " + scene + " --seconds 30 --rate 1 --no-bag --seed 1", 2000);
+      "segmenter_far_bin", qs::test::sceneSequenceArguments("desk", 1), 2000);
   ASSERT_TRUE(scored);
   std::printf("%s", scored->report().c_str());
-  // The generator numbers surfaces in the scene file's order (a box gives six): the bin is 23.
-  constexpr int kBin = 23;
-  const auto bin = scored->surfaces().find(kBin);
-  ASSERT_NE(bin, scored->surfaces().end());
-  ASSERT_EQ(bin->second.quadric_class, "cylinder");
-  EXPECT_GE(bin->second.frames_scored, 10) << "the bin is in view in a third of the sequence";
-  EXPECT_GE(bin->second.rate(), 0.85);
+  // The generator numbers surfaces in the scene file's order (a box gives six): the bin is 23, in
+  // view in a third of the sequence.
+  qs::test::expectSurfaceFound(*scored, 23, "cylinder", 10, 0.85);
   EXPECT_LE(scored->spuriousPerFrame(), 0.3);
 }

@@ -16,9 +16,8 @@ namespace qs = quadric_slam;
 TEST(QuadricSegmenterFarCone, TheRoomsConeIsAConeByItsOutlineAndItsCylinderACylinder) {
   if (qs::test::synthTool().empty())
     GTEST_SKIP() << "the synth tool is not built beside this test";
-  const std::string scene = std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/room.yaml";
   const std::optional<qs::SegmentationScore> scored = qs::test::scoreSynthSequence(
-      "segmenter_far_cone", "--scene " + scene + " --seconds 30 --rate 1 --no-bag --seed 1", 2000);
+      "segmenter_far_cone", qs::test::sceneSequenceArguments("room", 1), 2000);
   ASSERT_TRUE(scored);
   std::printf("%s", scored->report().c_str());
   int cones = 0, cylinders = 0;

@@ -18,18 +18,12 @@ namespace qs = quadric_slam;
 TEST(QuadricSegmenterLyingTube, TheDesksCappedTubeIsACylinder) {
   if (qs::test::synthTool().empty())
     GTEST_SKIP() << "the synth tool is not built beside this test";
-  const std::string scene = std::string(QUADRIC_SLAM_SOURCE_DIR) + "/config/scenes/desk.yaml";
   const std::optional<qs::SegmentationScore> scored = qs::test::scoreSynthSequence(
-      "segmenter_lying_tube", "--scene " + scene + " --seconds 30 --rate 1 --no-bag --seed 3",
-      2000);
+      "segmenter_lying_tube", qs::test::sceneSequenceArguments("desk", 3), 2000);
   ASSERT_TRUE(scored);
   std::printf("%s", scored->report().c_str());
-  // The generator numbers surfaces in the scene file's order (a box gives six): the tube is 11.
-  constexpr int kTube = 11;
-  const auto tube = scored->surfaces().find(kTube);
-  ASSERT_NE(tube, scored->surfaces().end());
-  ASSERT_EQ(tube->second.quadric_class, "cylinder");
-  EXPECT_GE(tube->second.frames_scored, 25) << "the tube is in view in most of the sequence";
-  EXPECT_GE(tube->second.rate(), 0.95);
+  // The generator numbers surfaces in the scene file's order (a box gives six): the tube is 11, in
+  // view in most of the sequence.
+  qs::test::expectSurfaceFound(*scored, 11, "cylinder", 25, 0.95);
   EXPECT_LE(scored->spuriousPerFrame(), 0.3);
 }
