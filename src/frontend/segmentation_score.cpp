@@ -121,6 +121,7 @@ void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat
     }
   ++frames_;
   last_missed_.clear();
+  last_spurious_.clear();
   auto scored = [&](int id) {
     const auto it = truth_classes_.find(id);
     return it != truth_classes_.end() && (it->second == "plane" || it->second == "sphere" ||
@@ -158,8 +159,11 @@ void SegmentationScore::addFrame(const Segmentation& segmentation, const cv::Mat
       ++spurious_;
       if (majority != 0 && it != truth_classes_.end() && !scored(majority))
         ++spurious_unmodelled_;
-      ++spurious_kinds_[toString(d.shape.quadric_class) + " on " +
-                        (it == truth_classes_.end() ? std::string("no surface") : it->second)];
+      const std::string on = it == truth_classes_.end() ? std::string("no surface") : it->second;
+      ++spurious_kinds_[toString(d.shape.quadric_class) + " on " + on];
+      last_spurious_.push_back(toString(d.shape.quadric_class) + " " + std::to_string(d.label) +
+                               " on " + on +
+                               (it == truth_classes_.end() ? "" : " " + std::to_string(majority)));
     }
   }
 }

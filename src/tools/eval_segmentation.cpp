@@ -7,7 +7,8 @@
 //
 //   eval_segmentation DIR [--stride K (1)] [--max-frames N (all)] [--min-pixels P (2000)]
 //                         [--config segmentation.yaml]
-//                         [--verbose 1: per frame, the stamp and the ids of missed surfaces]
+//                         [--verbose 1: per frame, the stamp, the ids of missed surfaces and the
+//                          spurious detections ("<class> <label> on <surface class> <id>")]
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -115,6 +116,12 @@ int main(int argc, char** argv) {
         std::printf("%s missed:", stamp.c_str());
         for (int id : score.lastMissed())
           std::printf(" %d", id);
+        std::printf("\n");
+      }
+      if (verbose && !score.lastSpurious().empty()) {
+        std::printf("%s spurious:", stamp.c_str());
+        for (std::size_t k = 0; k < score.lastSpurious().size(); ++k)
+          std::printf("%s %s", k ? ";" : "", score.lastSpurious()[k].c_str());
         std::printf("\n");
       }
       ++used;

@@ -42,6 +42,9 @@ class SegmentationScore {
   const std::map<int, Surface>& surfaces() const { return surfaces_; }
   // Scored surfaces not detected in the last frame added.
   const std::vector<int>& lastMissed() const { return last_missed_; }
+  // The spurious detections of the last frame added, as "<class> <label> on <surface class>
+  // <surface id>" ("on no surface" where the majority has no surface).
+  const std::vector<std::string>& lastSpurious() const { return last_spurious_; }
   int frames() const { return frames_; }
   int spurious() const { return spurious_; }
   double spuriousPerFrame() const { return frames_ ? double(spurious_) / frames_ : 0.0; }
@@ -74,6 +77,7 @@ class SegmentationScore {
   };
   std::map<std::string, std::vector<FitError>> errors_;  // class name -> found detections' errors
   std::vector<int> last_missed_;
+  std::vector<std::string> last_spurious_;
 };
 
 }  // namespace quadric_slam

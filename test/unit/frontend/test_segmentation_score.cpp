@@ -44,6 +44,7 @@ TEST(SegmentationScore, ErrorsKeptApartByRangeOfTheSupport) {
 
   EXPECT_EQ(score.frames(), 1);
   EXPECT_EQ(score.spurious(), 0);
+  EXPECT_TRUE(score.lastSpurious().empty());
   ASSERT_EQ(score.surfaces().size(), 2u);
   for (const auto& [id, surface] : score.surfaces())
     EXPECT_DOUBLE_EQ(surface.rate(), 1.0) << "surface " << id;
@@ -74,6 +75,8 @@ TEST(SegmentationScore, DetectionOfAnotherClassIsSpuriousAndMissesTheSurface) {
   score.addFrame(segmentation, truth, valid,
                  {{1, qs::PrimitiveShape::plane(Eigen::Vector3d::UnitZ(), 1.0)}});
   EXPECT_EQ(score.spurious(), 1);
+  ASSERT_EQ(score.lastSpurious().size(), 1u);
+  EXPECT_EQ(score.lastSpurious()[0], "cylinder 1 on plane 1");
   ASSERT_EQ(score.lastMissed().size(), 1u);
   EXPECT_EQ(score.lastMissed()[0], 1);
   EXPECT_TRUE(score.parameterErrors(0.0, 100.0).empty());
