@@ -2,10 +2,11 @@
 // overlap, are each verified once in parallel and kept as verified (the pixels the first takes do
 // not fit the second: its verdict cannot change); a duplicate candidate on the first cylinder's
 // pixels is verified again and dropped, as in the sequential order. assignLargestComponent reports
-// every pixel that fitted, in whichever component.
+// every pixel that fitted, in whichever component. A flat strip whose normals bend is no cylinder.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <vector>
@@ -173,4 +174,61 @@ TEST(CurvedVerification, AssignmentReportsEveryFittingPixel) {
   // sides face the camera alike, so the smaller does not join as the surface's other face).
   EXPECT_EQ(static_cast<int>(eligible.size()), seen);
   EXPECT_EQ(static_cast<int>(support.size()), std::max(left, seen - left));
+}
+
+// A flat strip of a wall whose normals bend across it as a cylinder's would: the normal
+// estimation's windows smooth across the strip's border with a neighbouring surface (a wall's strip
+// beside the floor). A cylinder proposed there, tangent to the strip with the normals' curvature,
+// fits the points no closer than their plane, and is not kept.
+TEST(CurvedVerification, AFlatStripWithBendingNormalsIsNoCylinder) {
+  constexpr int kTop = 20, kRows = 12;
+  constexpr double kWall = 0.9, kBend = 0.6;  // depth (m); normals' turn across the strip (rad)
+  pcl::PointCloud<pcl::PointNormal> cloud(kWidth, kHeight);
+  std::mt19937 random(11);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int v = 0; v < kHeight; ++v) {
+    for (int u = 0; u < kWidth; ++u) {
+      pcl::PointNormal& q = cloud(u, v);
+      q.x = q.y = q.z = q.normal_x = q.normal_y = q.normal_z = nan;
+      if (v < kTop || v >= kTop + kRows)
+        continue;
+      const double z = kWall + noise(random);
+      const double turn = kBend * (v - kTop) / (kRows - 1);
+      q.x = static_cast<float>((u - kCx) / kFocal * z);
+      q.y = static_cast<float>((v - kCy) / kFocal * z);
+      q.z = static_cast<float>(z);
+      q.normal_x = 0.0f;
+      q.normal_y = static_cast<float>(std::sin(turn));
+      q.normal_z = static_cast<float>(-std::cos(turn));
+    }
+  }
+  // The cylinder the normals describe: curvature kBend over the strip's height, axis along x,
+  // touching the strip along its middle row.
+  const double height = kRows * kWall / kFocal, radius = height / kBend;
+  const double middle_y = (kTop + 0.5 * kRows - kCy) / kFocal * kWall;
+  qs::CurvedCandidates candidates;
+  qs::CgalShapeDetector::Shape shape;
+  shape.shape = qs::PrimitiveShape::cylinder(Eigen::Vector3d(0.0, middle_y, kWall + radius),
+                                             Eigen::Vector3d::UnitX(), radius);
+  for (int v = kTop; v < kTop + kRows; v += 3)
+    for (int u = 0; u < kWidth; u += 3) {
+      shape.indices.push_back(static_cast<int>(candidates.points.size()));
+      candidates.points.push_back(qs::pointOf(cloud(u, v)));
+      candidates.normals.push_back(qs::normalOf(cloud(u, v)));
+      candidates.pixels.push_back(v * kWidth + u);
+    }
+  candidates.shapes.push_back(shape);
+  qs::SegmentationFrame frame = frameOf(cloud);
+  const qs::QuadricSegmenter::Params params;
+  const qs::ShapeRefiner refiner(params.refiner);
+  int accepted = 0;
+  qs::verifyCurvedCandidates(frame, candidates, params, refiner,
+                             [&](const std::vector<int>&, const qs::ShapeRefiner::Result& fit) {
+                               ++accepted;
+                               std::printf("kept: class %d, size %.3f, RMS %.4f m\n",
+                                           static_cast<int>(fit.shape.quadric_class),
+                                           fit.shape.size, fit.rms);
+                             });
+  EXPECT_EQ(accepted, 0);
 }
