@@ -7,7 +7,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -23,47 +25,59 @@ constexpr int kWidth = 120, kHeight = 60;
 constexpr double kFocal = 100.0, kCx = 60.0, kCy = 30.0;
 constexpr double kRadius = 0.1, kDepth = 1.0;
 
-// Upright cylinders (axis along the camera's y) at these x offsets, kDepth away; 1 mm of depth
-// noise along each ray; pixels that see no cylinder have no point.
-pcl::PointCloud<pcl::PointNormal> cylindersCloud(const std::vector<double>& centres_x) {
+// What a pixel's ray meets: the point and the surface's unit normal there.
+struct Seen {
+  Eigen::Vector3d point, normal;
+};
+
+// A kWidth x kHeight cloud: at each pixel, what `see` finds along the pixel's ray (through the
+// pinhole of kFocal, kCx, kCy; z component 1) at row v, or no point.
+pcl::PointCloud<pcl::PointNormal> rayCloud(
+    const std::function<std::optional<Seen>(const Eigen::Vector3d& ray, int v)>& see) {
   pcl::PointCloud<pcl::PointNormal> cloud(kWidth, kHeight);
-  std::mt19937 random(7);
-  std::normal_distribution<double> noise(0.0, 0.001);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (int v = 0; v < kHeight; ++v) {
     for (int u = 0; u < kWidth; ++u) {
       pcl::PointNormal& q = cloud(u, v);
       q.x = q.y = q.z = q.normal_x = q.normal_y = q.normal_z = nan;
-      const Eigen::Vector3d ray((u - kCx) / kFocal, (v - kCy) / kFocal, 1.0);
-      double nearest = std::numeric_limits<double>::infinity();
-      Eigen::Vector3d normal;
-      for (const double cx : centres_x) {
-        // (t ray_x - cx)^2 + (t ray_z - kDepth)^2 = r^2 in the x-z plane.
-        const double a = ray.x() * ray.x() + ray.z() * ray.z();
-        const double b = -2.0 * (ray.x() * cx + ray.z() * kDepth);
-        const double c = cx * cx + kDepth * kDepth - kRadius * kRadius;
-        const double discriminant = b * b - 4 * a * c;
-        if (discriminant < 0)
-          continue;
-        const double t = (-b - std::sqrt(discriminant)) / (2 * a);
-        if (t > 0 && t < nearest) {
-          nearest = t;
-          const Eigen::Vector3d p = t * ray;
-          normal = Eigen::Vector3d(p.x() - cx, 0.0, p.z() - kDepth) / kRadius;
-        }
-      }
-      if (!std::isfinite(nearest))
+      const std::optional<Seen> seen =
+          see(Eigen::Vector3d((u - kCx) / kFocal, (v - kCy) / kFocal, 1.0), v);
+      if (!seen)
         continue;
-      const Eigen::Vector3d p = (nearest + noise(random)) * ray;
-      q.x = static_cast<float>(p.x());
-      q.y = static_cast<float>(p.y());
-      q.z = static_cast<float>(p.z());
-      q.normal_x = static_cast<float>(normal.x());
-      q.normal_y = static_cast<float>(normal.y());
-      q.normal_z = static_cast<float>(normal.z());
+      q.getVector3fMap() = seen->point.cast<float>();
+      q.getNormalVector3fMap() = seen->normal.cast<float>();
     }
   }
   return cloud;
+}
+
+// Upright cylinders (axis along the camera's y) at these x offsets, kDepth away; 1 mm of depth
+// noise along each ray; pixels that see no cylinder have no point.
+pcl::PointCloud<pcl::PointNormal> cylindersCloud(const std::vector<double>& centres_x) {
+  std::mt19937 random(7);
+  std::normal_distribution<double> noise(0.0, 0.001);
+  return rayCloud([&](const Eigen::Vector3d& ray, int) -> std::optional<Seen> {
+    double nearest = std::numeric_limits<double>::infinity();
+    Eigen::Vector3d normal;
+    for (const double cx : centres_x) {
+      // (t ray_x - cx)^2 + (t ray_z - kDepth)^2 = r^2 in the x-z plane.
+      const double a = ray.x() * ray.x() + ray.z() * ray.z();
+      const double b = -2.0 * (ray.x() * cx + ray.z() * kDepth);
+      const double c = cx * cx + kDepth * kDepth - kRadius * kRadius;
+      const double discriminant = b * b - 4 * a * c;
+      if (discriminant < 0)
+        continue;
+      const double t = (-b - std::sqrt(discriminant)) / (2 * a);
+      if (t > 0 && t < nearest) {
+        nearest = t;
+        const Eigen::Vector3d p = t * ray;
+        normal = Eigen::Vector3d(p.x() - cx, 0.0, p.z() - kDepth) / kRadius;
+      }
+    }
+    if (!std::isfinite(nearest))
+      return std::nullopt;
+    return Seen{(nearest + noise(random)) * ray, normal};
+  });
 }
 
 qs::SegmentationFrame frameOf(const pcl::PointCloud<pcl::PointNormal>& cloud) {
@@ -183,26 +197,15 @@ TEST(CurvedVerification, AssignmentReportsEveryFittingPixel) {
 TEST(CurvedVerification, AFlatStripWithBendingNormalsIsNoCylinder) {
   constexpr int kTop = 20, kRows = 12;
   constexpr double kWall = 0.9, kBend = 0.6;  // depth (m); normals' turn across the strip (rad)
-  pcl::PointCloud<pcl::PointNormal> cloud(kWidth, kHeight);
   std::mt19937 random(11);
   std::normal_distribution<double> noise(0.0, 0.001);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (int v = 0; v < kHeight; ++v) {
-    for (int u = 0; u < kWidth; ++u) {
-      pcl::PointNormal& q = cloud(u, v);
-      q.x = q.y = q.z = q.normal_x = q.normal_y = q.normal_z = nan;
-      if (v < kTop || v >= kTop + kRows)
-        continue;
-      const double z = kWall + noise(random);
-      const double turn = kBend * (v - kTop) / (kRows - 1);
-      q.x = static_cast<float>((u - kCx) / kFocal * z);
-      q.y = static_cast<float>((v - kCy) / kFocal * z);
-      q.z = static_cast<float>(z);
-      q.normal_x = 0.0f;
-      q.normal_y = static_cast<float>(std::sin(turn));
-      q.normal_z = static_cast<float>(-std::cos(turn));
-    }
-  }
+  const auto cloud = rayCloud([&](const Eigen::Vector3d& ray, int v) -> std::optional<Seen> {
+    if (v < kTop || v >= kTop + kRows)
+      return std::nullopt;
+    const double turn = kBend * (v - kTop) / (kRows - 1);
+    return Seen{(kWall + noise(random)) * ray,
+                Eigen::Vector3d(0.0, std::sin(turn), -std::cos(turn))};
+  });
   // The cylinder the normals describe: curvature kBend over the strip's height, axis along x,
   // touching the strip along its middle row.
   const double height = kRows * kWall / kFocal, radius = height / kBend;
