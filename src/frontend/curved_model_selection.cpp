@@ -252,12 +252,12 @@ ShapeRefiner::Result selectCurvedModel(const ShapeRefiner::Result& refined,
       if (!as_cone)
         continue;
       // After an outline ruled a cone out, only a cone the outline shows.
-      if (cone_ruled_out && !coneMatchesTaper(as_cone->shape, fit.shape, taper))
+      const bool shown = coneMatchesTaper(as_cone->shape, fit.shape, taper);
+      if (cone_ruled_out && !shown)
         continue;
       // Far away the depth cannot tell them apart, the outline can: a cone that fits no worse
       // than the cylinder and whose opening the silhouette shows.
-      const bool outlined = as_cone->rms <= rms_allowance * cylinder_rms &&
-                            coneMatchesTaper(as_cone->shape, fit.shape, taper);
+      const bool outlined = as_cone->rms <= rms_allowance * cylinder_rms && shown;
       if (!(ratio * as_cone->rms < cylinder_rms ||
             coneSignificantlyBetter(as_cone->rms, cylinder_rms, points.size(), p) || outlined))
         continue;

@@ -306,10 +306,10 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
   // neither a plane (the grower rejects it as curved) nor a curved primitive.
   // A curved fit no closer to the points than their plane has no evidence of curvature in the
   // depths at all, however the normals bend: the normal estimation's windows smooth across a
-  // surface's border with its neighbour (on the generated desk, strips of a wall 14-27 pixels tall
-  // beside the floor, 0.9 m away, bent by 4-17 /m), and a cylinder fitted there stays in a minimum
-  // away from the plane (RMS 0.90-1.0 times the plane's). Where the depth noise hides a true
-  // cylinder's sag, its fit is still at least as close as the plane.
+  // surface's border with its neighbour (on the generated desk, strips of a flat face 14-27 pixels
+  // tall along the image's border beside the floor, 0.9 m away, bent by 4-17 /m), and a cylinder
+  // fitted there stays in a minimum away from the plane (RMS 0.90-1.0 times the plane's). Where the
+  // depth noise hides a true cylinder's sag, its fit is still at least as close as the plane.
   const PrimitiveShape plane = fitPlane(points);
   const double plane_rms = rmsDistance(plane, points);
   if (plane_rms <= fit.rms || (plane_rms < p.plane_rms_ratio * fit.rms &&
