@@ -6,6 +6,7 @@
 
 #include "quadric_slam/frontend/curved_shape_starts.h"
 #include "quadric_slam/frontend/curved_verification.h"
+#include "quadric_slam/frontend/grid_shape_ransac.h"
 #include "quadric_slam/frontend/parallel_chunks.h"
 #include "quadric_slam/frontend/plane_region_grower.h"
 
@@ -67,6 +68,7 @@ CurvedCandidates findCurvedCandidates(const SegmentationFrame& frame,
     std::size_t first = 0;
     int count = 0;
     int min_points = 0;
+    int stride = 1;  // of the component's sample, in grid pixels
     std::vector<CgalShapeDetector::Shape> shapes;
     std::exception_ptr error;
   };
@@ -89,6 +91,7 @@ CurvedCandidates findCurvedCandidates(const SegmentationFrame& frame,
     ComponentJob job;
     job.first = first;
     job.count = static_cast<int>(out.points.size() - first);
+    job.stride = stride;
     job.min_points =
         std::max(p.cgal_min_points, static_cast<int>(std::ceil(p.cgal_min_fraction * job.count)));
     if (job.count < job.min_points) {
@@ -106,7 +109,17 @@ CurvedCandidates findCurvedCandidates(const SegmentationFrame& frame,
                                               out.points.begin() + job.first + job.count);
     const std::vector<Eigen::Vector3d> normals(out.normals.begin() + job.first,
                                                out.normals.begin() + job.first + job.count);
-    job.shapes = CgalShapeDetector(params).detect(points, normals);
+    if (p.grid_ransac) {
+      std::vector<Eigen::Vector2i> cells;  // each sample's cell on the component's sample grid
+      cells.reserve(job.count);
+      for (int k = 0; k < job.count; ++k) {
+        const int pixel = out.pixels[job.first + k];
+        cells.emplace_back((pixel % width) / job.stride, (pixel / width) / job.stride);
+      }
+      job.shapes = GridShapeRansac(params).detect(points, normals, cells);
+    } else {
+      job.shapes = CgalShapeDetector(params).detect(points, normals);
+    }
     // CGAL's planes only absorb flat patches. A plane on points whose normals bend (curvature above
     // the grower's max_curvature) is a curved surface whose sag the depth noise hides (a far,
     // narrow strip of a cylinder fits a plane within epsilon): it becomes a cylinder candidate

@@ -66,6 +66,7 @@ const std::vector<Entry>& table() {
       flag("detect_spheres", [](Params& p) -> bool& { return p.detect_spheres; }),
       flag("detect_cylinders", [](Params& p) -> bool& { return p.detect_cylinders; }),
       flag("detect_cones", [](Params& p) -> bool& { return p.detect_cones; }),
+      flag("grid_ransac", [](Params& p) -> bool& { return p.grid_ransac; }),
       integer("cgal_stride", [](Params& p) -> int& { return p.cgal_stride; }),
       integer("cgal_max_points", [](Params& p) -> int& { return p.cgal_max_points; }),
       real("cgal_probability", [](Params& p) -> double& { return p.cgal_probability; }),
