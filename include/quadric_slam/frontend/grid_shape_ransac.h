@@ -21,9 +21,10 @@ class GridShapeRansac {
   using Params = CgalShapeDetector::Params;
   using Shape = CgalShapeDetector::Shape;
 
-  // Grid cells at most this far apart (in u or v) are neighbours of a support: one missing cell
-  // (a point without depth, or off the surface by noise) does not split a surface.
-  static constexpr int kClusterCells = 2;
+  // Grid cells at most this far apart (in u or v) are neighbours of a support: gaps of two cells
+  // (points without depth, or off the surface by the noise) do not split a surface. At 3 m the
+  // depth noise exceeds a typical epsilon and only about a third of a surface's points fit it.
+  static constexpr int kClusterCells = 3;
 
   explicit GridShapeRansac(const Params& params);
 

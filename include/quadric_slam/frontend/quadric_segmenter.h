@@ -122,11 +122,12 @@ class QuadricSegmenter {
     // CGAL runs once per connected component of the free points; its minimum support there is
     // max(cgal_min_points, cgal_min_fraction * sub-sampled component size), [0, 1).
     double cgal_min_fraction = 0.08;
-    // The curved candidates from GridShapeRansac (grid_shape_ransac.h: the components' samples
-    // connected through the image grid, candidates scored directly) instead of CGAL's Efficient
-    // RANSAC, with the same cgal_* parameters. About 2.5 ms faster per frame (RANSAC median 4.3 ->
-    // 1.8 ms, p95 9.5 -> 3 ms), but lower curved recall on the harsh generated scenes (a far open
-    // bin, far cones). Default false.
+    // true: the curved candidates come from GridShapeRansac (grid_shape_ransac.h: the component's
+    // sample connected through the image grid, proposals scored directly, each class's best
+    // refitted before the classes are compared) with the cgal_* parameters (cluster epsilon
+    // aside); false: from CGAL's Efficient RANSAC. At a quarter of CGAL's instructions the same
+    // curved recall on the harsh generated scenes and the mOSD scenes, but more spurious curved
+    // segments on the desk scenes (docs/segmentation/README.md). Default false.
     bool grid_ransac = false;
     // Assignment of full-resolution pixels to a curved shape: distance threshold
     // max(min_distance, distance_factor * z^2) of the planes, and this normal angle (rad),
