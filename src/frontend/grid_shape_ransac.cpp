@@ -145,19 +145,6 @@ double rankOf(const PrimitiveShape& shape, int score) {
   }
 }
 
-int classSlot(QuadricClass c) {
-  switch (c) {
-    case QuadricClass::kPlane:
-      return 0;
-    case QuadricClass::kSphere:
-      return 1;
-    case QuadricClass::kCylinder:
-      return 2;
-    default:
-      return 3;
-  }
-}
-
 }  // namespace
 
 GridShapeRansac::GridShapeRansac(const Params& params) : params_(params) {
@@ -291,15 +278,16 @@ std::vector<GridShapeRansac::Shape> GridShapeRansac::detect(
     }
     if (!best.shape || best.score < min_points)
       break;
-    // Each class's best, refitted, then compared.
+    // Each class's best, refitted when near the best, then compared (a tie goes to the class
+    // listed first: plane, sphere, cylinder, cone).
     const double refit_rank = kRefitShare * best.rank;
+    best = Candidate();
     for (Candidate& candidate : class_best) {
-      if (!candidate.shape || candidate.rank < refit_rank)
+      if (!candidate.shape)
         continue;
-      refit(candidate);
-      if (candidate.rank > best.rank ||
-          (candidate.rank == best.rank &&
-           classSlot(candidate.shape->quadric_class) < classSlot(best.shape->quadric_class)))
+      if (candidate.rank >= refit_rank)
+        refit(candidate);
+      if (candidate.rank > best.rank)
         best = candidate;
     }
     // The support: the largest grid-connected set of the free points that fit.

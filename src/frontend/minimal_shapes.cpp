@@ -5,6 +5,23 @@
 
 namespace quadric_slam {
 
+namespace {
+
+// The midpoint of the closest approach of the lines a + t u and b + s v (u, v unit); none when
+// they are (nearly) parallel.
+std::optional<Eigen::Vector3d> closestApproach(const Eigen::Vector3d& a, const Eigen::Vector3d& u,
+                                               const Eigen::Vector3d& b, const Eigen::Vector3d& v) {
+  const Eigen::Vector3d w = a - b;
+  const double c = u.dot(v), d = u.dot(w), e = v.dot(w);
+  const double denom = 1.0 - c * c;
+  if (denom < 1e-6)
+    return std::nullopt;
+  const double t = (c * e - d) / denom, s = (e - c * d) / denom;
+  return Eigen::Vector3d(0.5 * (a + t * u + b + s * v));
+}
+
+}  // namespace
+
 // The plane through three points.
 std::optional<PrimitiveShape> planeThrough(const OrientedPoint* s) {
   const Eigen::Vector3d n = (s[1].p - s[0].p).cross(s[2].p - s[0].p);
@@ -16,15 +33,11 @@ std::optional<PrimitiveShape> planeThrough(const OrientedPoint* s) {
 
 // The sphere whose centre lies on both points' normal lines (their closest approach).
 std::optional<PrimitiveShape> sphereThrough(const OrientedPoint* s) {
-  const Eigen::Vector3d w = s[0].p - s[1].p;
-  const double b = s[0].n.dot(s[1].n), d = s[0].n.dot(w), e = s[1].n.dot(w);
-  const double denom = 1.0 - b * b;
-  if (denom < 1e-6)
+  const std::optional<Eigen::Vector3d> centre = closestApproach(s[0].p, s[0].n, s[1].p, s[1].n);
+  if (!centre)
     return std::nullopt;
-  const double t = (b * e - d) / denom, u = (e - b * d) / denom;
-  const Eigen::Vector3d centre = 0.5 * (s[0].p + t * s[0].n + s[1].p + u * s[1].n);
-  const double radius = 0.5 * ((s[0].p - centre).norm() + (s[1].p - centre).norm());
-  return PrimitiveShape::sphere(centre, radius);
+  const double radius = 0.5 * ((s[0].p - *centre).norm() + (s[1].p - *centre).norm());
+  return PrimitiveShape::sphere(*centre, radius);
 }
 
 // The cylinder whose axis is perpendicular to both normals and meets both normal lines (in the
@@ -38,16 +51,12 @@ std::optional<PrimitiveShape> cylinderThrough(const OrientedPoint* s) {
     return v - axis.dot(v) * axis;
   };
   const Eigen::Vector3d q0 = across(s[0].p), q1 = across(s[1].p);
-  const Eigen::Vector3d m0 = across(s[0].n).normalized(), m1 = across(s[1].n).normalized();
-  const Eigen::Vector3d w = q0 - q1;
-  const double b = m0.dot(m1), d = m0.dot(w), e = m1.dot(w);
-  const double denom = 1.0 - b * b;
-  if (denom < 1e-6)
+  const std::optional<Eigen::Vector3d> centre =
+      closestApproach(q0, across(s[0].n).normalized(), q1, across(s[1].n).normalized());
+  if (!centre)
     return std::nullopt;
-  const double t = (b * e - d) / denom, u = (e - b * d) / denom;
-  const Eigen::Vector3d centre = 0.5 * (q0 + t * m0 + q1 + u * m1);
-  const double radius = 0.5 * ((q0 - centre).norm() + (q1 - centre).norm());
-  return PrimitiveShape::cylinder(centre, axis, radius);
+  const double radius = 0.5 * ((q0 - *centre).norm() + (q1 - *centre).norm());
+  return PrimitiveShape::cylinder(*centre, axis, radius);
 }
 
 // The cone tangent to the three points' planes: the apex where the three tangent planes meet; the

@@ -29,7 +29,8 @@ class GridShapeRansac {
   explicit GridShapeRansac(const Params& params);
 
   // points, normals (unit, sign free) and each point's cell on the sample grid (distinct cells)
-  // have the same length. Shapes in detection order (largest support first, as found).
+  // have the same length. Shapes in the order found, each the best on the points the earlier
+  // ones left.
   std::vector<Shape> detect(const std::vector<Eigen::Vector3d>& points,
                             const std::vector<Eigen::Vector3d>& normals,
                             const std::vector<Eigen::Vector2i>& cells) const;
