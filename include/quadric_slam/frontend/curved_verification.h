@@ -1,8 +1,9 @@
 // Step 3 of the segmenter: each curved candidate of step 2 (curved_candidates.h), biggest first, is
 // refined on its free points, re-assigned to the largest connected set of free pixels that fit it,
 // put through model selection (a simpler class that fits almost as well wins), and kept only when
-// it is no plane in disguise, its residuals are noise rather than shape (else an ellipsoid is
-// sought there, class general) and its RMS is within the sensor's noise; and the checks it uses.
+// it is no plane in disguise, its residuals are noise rather than shape, on its support and on the
+// unsegmented surface it continues into without a depth jump (else an ellipsoid is sought there,
+// class general), and its RMS is within the sensor's noise; and the checks it uses.
 #pragma once
 
 #include <Eigen/Core>

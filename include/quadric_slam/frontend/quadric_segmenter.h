@@ -157,7 +157,10 @@ class QuadricSegmenter {
     // sphere on an ellipsoid) and is dropped; not when the general quadric fits the noise band
     // with two close sheets that split neighbouring points (under 3/4 of the grid neighbours on
     // one sheet), which undercuts any true surface's RMS, nor when along the pixels' rays it
-    // explains the depths no better than the fit (ray_residual.h). >= 1; default 1.3.
+    // explains the depths no better than the fit (ray_residual.h). The test also runs on the
+    // points with the unsegmented surface they continue into without a depth jump, when one
+    // quadric fits that at least as closely as the fit its points (curved_verification.h).
+    // >= 1; default 1.3.
     double quadric_rms_ratio = 1.3;
     // Report what the shape test finds as a detection of class general when the general quadric
     // is an ellipsoid with semi-axes within [min_sphere_radius, max_sphere_radius]

@@ -3,6 +3,7 @@
 // not fit the second: its verdict cannot change); a duplicate candidate on the first cylinder's
 // pixels is verified again and dropped, as in the sequential order. assignLargestComponent reports
 // every pixel that fitted, in whichever component. A flat strip whose normals bend is no cylinder.
+// A cylinder along the middle of an elongated ellipsoid is reported as the ellipsoid.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -234,4 +235,54 @@ TEST(CurvedVerification, AFlatStripWithBendingNormalsIsNoCylinder) {
                                            fit.shape.size, fit.rms);
                              });
   EXPECT_EQ(accepted, 0);
+}
+
+// An elongated ellipsoid lying across the view, with depth noise that hides its shape on the strip
+// a cylinder along its long axis fits: that support alone passes the shape test. Beyond the support
+// the surface continues without a depth jump (the ellipsoid's ends), where the cylinder fails and
+// one quadric fits: the ellipsoid is reported instead of the cylinder.
+TEST(CurvedVerification, ACylinderAlongAnEllipsoidIsTheEllipsoid) {
+  const Eigen::Vector3d centre(0.0, 0.0, 0.6), semi_axes(0.13, 0.08, 0.07);
+  std::mt19937 random(5);
+  std::normal_distribution<double> noise(0.0, 0.004);
+  const auto cloud = rayCloud([&](const Eigen::Vector3d& ray, int) -> std::optional<Seen> {
+    // sum_i ((t ray_i - centre_i) / semi_axis_i)^2 = 1
+    const Eigen::Vector3d r = ray.cwiseQuotient(semi_axes), c = centre.cwiseQuotient(semi_axes);
+    const double a = r.squaredNorm(), b = -2.0 * r.dot(c), d = c.squaredNorm() - 1.0;
+    const double discriminant = b * b - 4 * a * d;
+    if (discriminant < 0)
+      return std::nullopt;
+    const double t = (-b - std::sqrt(discriminant)) / (2 * a);
+    const Eigen::Vector3d p = t * ray;
+    const Eigen::Vector3d normal =
+        (p - centre).cwiseQuotient(semi_axes.cwiseProduct(semi_axes)).normalized();
+    return Seen{(t + noise(random)) * ray, normal};
+  });
+  qs::CurvedCandidates candidates;
+  qs::CgalShapeDetector::Shape shape;
+  shape.shape = qs::PrimitiveShape::cylinder(centre, Eigen::Vector3d::UnitX(), 0.075);
+  for (int v = 0; v < kHeight; v += 3)
+    for (int u = 0; u < kWidth; u += 3) {
+      const pcl::PointNormal& q = cloud(u, v);
+      if (!std::isfinite(q.z) || std::abs(shape.shape.distance(qs::pointOf(q))) > 0.01)
+        continue;
+      shape.indices.push_back(static_cast<int>(candidates.points.size()));
+      candidates.points.push_back(qs::pointOf(q));
+      candidates.normals.push_back(qs::normalOf(q));
+      candidates.pixels.push_back(v * kWidth + u);
+    }
+  candidates.shapes.push_back(shape);
+  qs::SegmentationFrame frame = frameOf(cloud);
+  const qs::QuadricSegmenter::Params params;
+  const qs::ShapeRefiner refiner(params.refiner);
+  std::vector<qs::QuadricClass> kept;
+  qs::verifyCurvedCandidates(
+      frame, candidates, params, refiner,
+      [&](const std::vector<int>& indices, const qs::ShapeRefiner::Result& fit) {
+        kept.push_back(fit.shape.quadric_class);
+        std::printf("kept: class %d, %zu points, RMS %.4f m\n",
+                    static_cast<int>(fit.shape.quadric_class), indices.size(), fit.rms);
+      });
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept.front(), qs::QuadricClass::kGeneral);
 }
