@@ -126,8 +126,9 @@ class QuadricSegmenter {
     // sample connected through the image grid, proposals scored directly, each class's best
     // refitted before the classes are compared) with the cgal_* parameters (cluster epsilon
     // aside); false: from CGAL's Efficient RANSAC. At a quarter of CGAL's instructions the same
-    // curved recall on the harsh generated scenes and the mOSD scenes, but more spurious curved
-    // segments on the desk scenes (docs/segmentation/README.md). Default false.
+    // curved recall and spurious count on the harsh generated scenes, but fewer frames of a far
+    // cone and more thin cylinders on surfaces cut by the image border
+    // (docs/segmentation/README.md). Default false.
     bool grid_ransac = false;
     // Assignment of full-resolution pixels to a curved shape: distance threshold
     // max(min_distance, distance_factor * z^2) of the planes, and this normal angle (rad),
