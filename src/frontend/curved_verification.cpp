@@ -390,9 +390,9 @@ CandidateVerdict verifyCandidate(const SegmentationFrame& frame,
   // own distance and normal tests, exactly the parts where it fails. Only when one quadric fits the
   // wider surface at least as closely as the primitive fits its support: beside a true primitive
   // the continuation is another surface met without a depth jump (a lying cylinder's end caps and
-  // the unsegmented strip of the plane it rests on), which a general quadric bends towards, and
-  // fits 1.7-3.5 times as badly as the primitive its support (generated desk; the ends of
-  // an ellipsoid beyond a cylinder: 0.5-0.6 times).
+  // the unsegmented strip of the plane it rests on), which a general quadric bends towards and
+  // then fits 1.7-3.5 times worse than the primitive fits its support (generated desk; the ends
+  // of an ellipsoid beyond a cylinder: 0.5-0.6 times).
   if (!shape_found) {
     const std::vector<int> beyond =
         smoothContinuation(frame, indices, roi, p.planes.max_depth_jump_factor);

@@ -89,28 +89,39 @@ qs::SegmentationFrame frameOf(const pcl::PointCloud<pcl::PointNormal>& cloud) {
   return frame;
 }
 
-// A candidate per cylinder, its sample every third pixel of the pixels that see it (CGAL's
-// stride), proposed as the cylinder itself; `duplicate_first` proposes the first one twice.
+// A candidate proposed as `shape`, its sample every third pixel (CGAL's stride) of the pixels
+// within 1 cm of it, appended to the candidates' sample arrays.
+qs::CgalShapeDetector::Shape sampledCandidate(const pcl::PointCloud<pcl::PointNormal>& cloud,
+                                              const qs::PrimitiveShape& shape,
+                                              qs::CurvedCandidates& candidates) {
+  qs::CgalShapeDetector::Shape candidate;
+  candidate.shape = shape;
+  for (int v = 0; v < kHeight; v += 3) {
+    for (int u = 0; u < kWidth; u += 3) {
+      const pcl::PointNormal& q = cloud(u, v);
+      if (!std::isfinite(q.z) || std::abs(shape.distance(qs::pointOf(q))) > 0.01)
+        continue;
+      candidate.indices.push_back(static_cast<int>(candidates.points.size()));
+      candidates.points.push_back(qs::pointOf(q));
+      candidates.normals.push_back(qs::normalOf(q));
+      candidates.pixels.push_back(v * kWidth + u);
+    }
+  }
+  return candidate;
+}
+
+// A candidate per cylinder (sampledCandidate), proposed as the cylinder itself; `duplicate_first`
+// proposes the first one twice.
 qs::CurvedCandidates candidatesOf(const pcl::PointCloud<pcl::PointNormal>& cloud,
                                   const std::vector<double>& centres_x, bool duplicate_first) {
   qs::CurvedCandidates candidates;
   std::vector<qs::CgalShapeDetector::Shape> shapes;
   for (const double cx : centres_x) {
-    qs::CgalShapeDetector::Shape shape;
-    shape.shape = qs::PrimitiveShape::cylinder(Eigen::Vector3d(cx, 0.0, kDepth),
-                                               Eigen::Vector3d::UnitY(), kRadius);
-    for (int v = 0; v < kHeight; v += 3) {
-      for (int u = 0; u < kWidth; u += 3) {
-        const pcl::PointNormal& q = cloud(u, v);
-        if (!std::isfinite(q.z) || std::abs(shape.shape.distance(qs::pointOf(q))) > 0.01)
-          continue;
-        shape.indices.push_back(static_cast<int>(candidates.points.size()));
-        candidates.points.push_back(qs::pointOf(q));
-        candidates.normals.push_back(qs::normalOf(q));
-        candidates.pixels.push_back(v * kWidth + u);
-      }
-    }
-    shapes.push_back(shape);
+    shapes.push_back(
+        sampledCandidate(cloud,
+                         qs::PrimitiveShape::cylinder(Eigen::Vector3d(cx, 0.0, kDepth),
+                                                      Eigen::Vector3d::UnitY(), kRadius),
+                         candidates));
   }
   candidates.shapes = shapes;
   if (duplicate_first)
@@ -259,19 +270,8 @@ TEST(CurvedVerification, ACylinderAlongAnEllipsoidIsTheEllipsoid) {
     return Seen{(t + noise(random)) * ray, normal};
   });
   qs::CurvedCandidates candidates;
-  qs::CgalShapeDetector::Shape shape;
-  shape.shape = qs::PrimitiveShape::cylinder(centre, Eigen::Vector3d::UnitX(), 0.075);
-  for (int v = 0; v < kHeight; v += 3)
-    for (int u = 0; u < kWidth; u += 3) {
-      const pcl::PointNormal& q = cloud(u, v);
-      if (!std::isfinite(q.z) || std::abs(shape.shape.distance(qs::pointOf(q))) > 0.01)
-        continue;
-      shape.indices.push_back(static_cast<int>(candidates.points.size()));
-      candidates.points.push_back(qs::pointOf(q));
-      candidates.normals.push_back(qs::normalOf(q));
-      candidates.pixels.push_back(v * kWidth + u);
-    }
-  candidates.shapes.push_back(shape);
+  candidates.shapes.push_back(sampledCandidate(
+      cloud, qs::PrimitiveShape::cylinder(centre, Eigen::Vector3d::UnitX(), 0.075), candidates));
   qs::SegmentationFrame frame = frameOf(cloud);
   const qs::QuadricSegmenter::Params params;
   const qs::ShapeRefiner refiner(params.refiner);
