@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -49,7 +50,9 @@ constexpr double kNoiseGate = 3.0;
 }  // namespace
 
 Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
-                      const QuadricSegmenter::Params& p) {
+                      const QuadricSegmenter::Params& p, const std::vector<std::uint8_t>& taken) {
+  if (!taken.empty() && taken.size() != cloud.size())
+    throw std::invalid_argument("upsample: taken must hold one flag per point of the cloud");
   Segmentation result;
   result.timings = coarse.timings;
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
@@ -93,7 +96,10 @@ Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentati
     // Labels pixel (u, v) with the best of the distinct candidate labels, if any fits.
     const auto labelPixel = [&](int u, int v, const std::uint16_t* labels, int distinct,
                                 bool single_surface, std::uint16_t* label_row) {
-      const pcl::PointNormal& q = cloud.points[static_cast<std::size_t>(v) * width + u];
+      const std::size_t index = static_cast<std::size_t>(v) * width + u;
+      if (!taken.empty() && taken[index])
+        return;
+      const pcl::PointNormal& q = cloud.points[index];
       if (!(q.z >= min_range && q.z <= max_range) || !std::isfinite(q.x) || !std::isfinite(q.y) ||
           !std::isfinite(q.normal_x) || !std::isfinite(q.normal_y) || !std::isfinite(q.normal_z))
         return;

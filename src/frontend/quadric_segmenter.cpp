@@ -159,14 +159,9 @@ Segmentation segmentCurvedCoarser(const SegmentationFrame& frame, const QuadricS
   start = std::chrono::steady_clock::now();
   timings.curved_verified_again = verifyCurvedCandidates(coarse_frame, candidates, coarse_params,
                                                          refiner, acceptInto(coarse_frame, coarse));
-  // The curved segments take only the free points of frame's grid: the others (planes, invalid)
-  // are hidden from the labelling.
-  pcl::PointCloud<pcl::PointNormal> free_points = frame.cloud;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (std::size_t i = 0; i < free_points.size(); ++i)
-    if (frame.used[i] || !frame.valid[i])
-      free_points.points[i].z = nan;
-  Segmentation curved = upsample(free_points, std::move(coarse), c, p);
+  // The curved segments take only the free points of frame's grid (the labelling's own tests leave
+  // out the invalid ones: no depth in range, no normal).
+  Segmentation curved = upsample(frame.cloud, std::move(coarse), c, p, frame.used);
   timings.verify_ms = msSince(start);
   return curved;
 }

@@ -161,12 +161,12 @@ void normalEquations(const PrimitiveShape& shape, const std::vector<Eigen::Vecto
 
 // Covariance of the fit: sigma^2 (J^T J)^-1, J over all points (the sub-sample's normal matrix
 // scaled by N / n), sigma^2 the residual variance.
+// cost: the sum of the squared distances of points to shape.
 ShapeRefiner::Result covarianceOf(const PrimitiveShape& shape,
-                                  const std::vector<Eigen::Vector3d>& points,
+                                  const std::vector<Eigen::Vector3d>& points, double cost,
                                   std::size_t all_points) {
   ShapeRefiner::Result result;
   const int k = minimalDimension(shape.quadric_class);
-  const double cost = residuals(shape, points).squaredNorm();
   Eigen::MatrixXd H;
   Eigen::VectorXd unused;
   normalEquations(shape, points, Eigen::VectorXd::Zero(points.size()), H, unused);
@@ -249,7 +249,7 @@ ShapeRefiner::Result ShapeRefiner::refineUnchecked(
       break;
   }
 
-  return covarianceOf(shape, points, all_points.size());
+  return covarianceOf(shape, points, cost, all_points.size());
 }
 
 ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
@@ -260,7 +260,8 @@ ShapeRefiner::Result ShapeRefiner::evaluate(const PrimitiveShape& shape,
       !validShape(shape))
     return result;
   try {
-    return covarianceOf(shape, evenSubsample(all_points, params_.max_points), all_points.size());
+    const std::vector<Eigen::Vector3d> points = evenSubsample(all_points, params_.max_points);
+    return covarianceOf(shape, points, residuals(shape, points).squaredNorm(), all_points.size());
   } catch (const std::invalid_argument&) {
     return result;
   }

@@ -22,8 +22,10 @@ pcl::PointCloud<pcl::PointNormal> decimated(const pcl::PointCloud<pcl::PointNorm
 // the label of a neighbouring coarse sample whose surface it fits (distance threshold and normal
 // agreement, as on the coarse grid; no normal needed within 3 x the fit's RMS of a surface that is
 // the only one among the neighbouring samples);
-// support, fit RMS, ROI, extent and covariance follow the full-resolution points.
+// support, fit RMS, ROI, extent and covariance follow the full-resolution points. Pixels flagged in
+// taken (one flag per point of cloud; empty: none) stay unlabelled: those other segments hold.
 Segmentation upsample(const pcl::PointCloud<pcl::PointNormal>& cloud, Segmentation coarse, int d,
-                      const QuadricSegmenter::Params& p);
+                      const QuadricSegmenter::Params& p,
+                      const std::vector<std::uint8_t>& taken = std::vector<std::uint8_t>());
 
 }  // namespace quadric_slam
