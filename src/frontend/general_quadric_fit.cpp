@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "quadric_slam/frontend/levenberg_marquardt.h"
 #include "quadric_slam/frontend/shape_refiner.h"
 
 namespace quadric_slam {
@@ -111,43 +112,36 @@ GeneralQuadricFit fitGeneralQuadric(const std::vector<Eigen::Vector3d>& all_poin
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 10, 10>> eig(M);
   Vector10d c = eig.eigenvectors().col(0);
 
-  // Levenberg-Marquardt on the Sampson distances (scale-free in c: renormalised each step).
-  Eigen::VectorXd r = residuals(c, x);
-  double cost = r.squaredNorm();
-  double lambda = 1e-3;
-  for (int it = 0; it < iterations; ++it) {
-    // J^T J and J^T r accumulated row by row in fixed-size matrices (no n x 10 Jacobian).
-    Eigen::Matrix<double, 10, 10> H = Eigen::Matrix<double, 10, 10>::Zero();
-    Vector10d g = Vector10d::Zero();
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      Vector10d row;
-      sampsonDistance(c, x[i], &row);
-      H.noalias() += row * row.transpose();
-      g += row * r[static_cast<Eigen::Index>(i)];
-    }
-    bool improved = false;
-    for (int attempt = 0; attempt < 6 && !improved; ++attempt) {
-      Eigen::Matrix<double, 10, 10> A = H;
-      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-12);
-      Vector10d candidate = c + A.ldlt().solve(-g);
-      if (!candidate.allFinite())
-        break;
-      candidate.normalize();
-      const Eigen::VectorXd r_new = residuals(candidate, x);
-      const double cost_new = r_new.squaredNorm();
-      if (std::isfinite(cost_new) && cost_new < cost) {
-        c = candidate;
-        r = r_new;
-        cost = cost_new;
-        lambda = std::max(lambda / 10, 1e-9);
-        improved = true;
-      } else {
-        lambda *= 10;
-      }
-    }
-    if (!improved)
-      break;
-  }
+  // Levenberg-Marquardt on the Sampson distances (scale-free in c: renormalised each step; 9
+  // degrees of freedom), until a step gains less than a tenth of the residual variance
+  // (convergedWithinNoise).
+  LevenbergMarquardtSettings settings;
+  settings.max_iterations = iterations;
+  settings.relative_tolerance = 0.0;
+  settings.variance_tolerance = 0.1;
+  settings.initial_lambda = 1e-3;
+  Eigen::VectorXd r;
+  double cost = 0.0;
+  c = minimiseSquares(
+      c, 9, settings, [&](const Vector10d& coefficients) { return residuals(coefficients, x); },
+      [&](const Vector10d& coefficients, const Eigen::VectorXd& rc, Eigen::MatrixXd& H,
+          Eigen::VectorXd& g) {
+        // J^T J and J^T r accumulated row by row in fixed-size matrices (no n x 10 Jacobian).
+        Eigen::Matrix<double, 10, 10> HH = Eigen::Matrix<double, 10, 10>::Zero();
+        Vector10d gg = Vector10d::Zero();
+        for (std::size_t i = 0; i < x.size(); ++i) {
+          Vector10d row;
+          sampsonDistance(coefficients, x[i], &row);
+          HH.noalias() += row * row.transpose();
+          gg += row * rc[static_cast<Eigen::Index>(i)];
+        }
+        H = HH;
+        g = gg;
+      },
+      [](const Vector10d& coefficients, const Eigen::VectorXd& step) -> std::optional<Vector10d> {
+        return Vector10d((coefficients + step).normalized());
+      },
+      r, cost);
   fit.coefficients = c;
   fit.rms = fit.spread * std::sqrt(cost / static_cast<double>(n));
   fit.ok = true;

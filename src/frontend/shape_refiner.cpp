@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "quadric_slam/frontend/levenberg_marquardt.h"
 #include "quadric_slam/geometry/quadric_classes.h"
 
 namespace quadric_slam {
@@ -18,6 +19,9 @@ void ShapeRefiner::Params::validate() const {
   if (!(relative_tolerance > 0 && relative_tolerance < 1))
     throw std::invalid_argument("ShapeRefiner: relative_tolerance must be in (0, 1), got " +
                                 std::to_string(relative_tolerance));
+  if (!(variance_tolerance >= 0 && variance_tolerance <= 1))
+    throw std::invalid_argument("ShapeRefiner: variance_tolerance must be in [0, 1], got " +
+                                std::to_string(variance_tolerance));
   if (max_points < 10 || max_points > 10000000)
     throw std::invalid_argument("ShapeRefiner: max_points must be in [10, 1e7], got " +
                                 std::to_string(max_points));
@@ -208,46 +212,25 @@ ShapeRefiner::Result ShapeRefiner::refineUnchecked(
 
   const std::vector<Eigen::Vector3d> points = evenSubsample(all_points, params_.max_points);
 
-  PrimitiveShape shape = initial;
-  Eigen::VectorXd r = residuals(shape, points);
-  double cost = r.squaredNorm();
-  double lambda = 1e-4;
-  for (int it = 0; it < params_.max_iterations; ++it) {
-    Eigen::MatrixXd H;
-    Eigen::VectorXd g;
-    normalEquations(shape, points, r, H, g);
-    bool improved = false;
-    for (int attempt = 0; attempt < 10 && !improved; ++attempt) {
-      Eigen::MatrixXd A = H;
-      A.diagonal() += lambda * H.diagonal().cwiseMax(1e-12);
-      const Eigen::VectorXd delta = A.ldlt().solve(-g);
-      if (!delta.allFinite())
-        break;
-      PrimitiveShape candidate;
-      try {
-        candidate = perturb(shape, delta);
-      } catch (const std::invalid_argument&) {  // step left the class (e.g. negative scale)
-        lambda *= 10;
-        continue;
-      }
-      const Eigen::VectorXd r_new = residuals(candidate, points);
-      const double cost_new = r_new.squaredNorm();
-      if (std::isfinite(cost_new) && cost_new < cost) {
-        const double decrease = (cost - cost_new) / std::max(cost, 1e-300);
-        shape = candidate;
-        r = r_new;
-        cost = cost_new;
-        lambda = std::max(lambda / 10, 1e-9);
-        improved = true;
-        if (decrease < params_.relative_tolerance)
-          it = params_.max_iterations;
-      } else {
-        lambda *= 10;
-      }
-    }
-    if (!improved)
-      break;
-  }
+  LevenbergMarquardtSettings settings;
+  settings.max_iterations = params_.max_iterations;
+  settings.relative_tolerance = params_.relative_tolerance;
+  settings.variance_tolerance = params_.variance_tolerance;
+  settings.initial_lambda = 1e-4;
+  Eigen::VectorXd r;
+  double cost = 0.0;
+  const PrimitiveShape shape = minimiseSquares(
+      initial, k, settings, [&](const PrimitiveShape& s) { return residuals(s, points); },
+      [&](const PrimitiveShape& s, const Eigen::VectorXd& rs, Eigen::MatrixXd& H,
+          Eigen::VectorXd& g) { normalEquations(s, points, rs, H, g); },
+      [](const PrimitiveShape& s, const Eigen::VectorXd& step) -> std::optional<PrimitiveShape> {
+        try {
+          return perturb(s, step);
+        } catch (const std::invalid_argument&) {  // the step left the class (e.g. negative scale)
+          return std::nullopt;
+        }
+      },
+      r, cost);
 
   return covarianceOf(shape, points, cost, all_points.size());
 }

@@ -17,6 +17,10 @@ class ShapeRefiner {
     int max_iterations = 10;
     // Stop when the step's relative cost decrease is below this, (0, 1). Default 1e-6.
     double relative_tolerance = 1e-6;
+    // Or when a step lowered the cost by less than this many residual variances: the fit is then
+    // within about sqrt(this) standard deviations of its optimum (convergedWithinNoise,
+    // levenberg_marquardt.h); [0, 1], 0 = off. Default 0.1.
+    double variance_tolerance = 0.1;
     // Points used at most (an even sub-sample beyond this; the covariance is scaled back to all
     // points), [10, 1e7]. Default 1000.
     int max_points = 1000;
