@@ -120,7 +120,6 @@ GeneralQuadricFit fitGeneralQuadric(const std::vector<Eigen::Vector3d>& all_poin
   settings.relative_tolerance = 0.0;
   settings.variance_tolerance = 0.1;
   settings.initial_lambda = 1e-3;
-  Eigen::VectorXd r;
   double cost = 0.0;
   c = minimiseSquares(
       c, 9, settings, [&](const Vector10d& coefficients) { return residuals(coefficients, x); },
@@ -141,7 +140,7 @@ GeneralQuadricFit fitGeneralQuadric(const std::vector<Eigen::Vector3d>& all_poin
       [](const Vector10d& coefficients, const Eigen::VectorXd& step) -> std::optional<Vector10d> {
         return Vector10d((coefficients + step).normalized());
       },
-      r, cost);
+      cost);
   fit.coefficients = c;
   fit.rms = fit.spread * std::sqrt(cost / static_cast<double>(n));
   fit.ok = true;

@@ -217,7 +217,6 @@ ShapeRefiner::Result ShapeRefiner::refineUnchecked(
   settings.relative_tolerance = params_.relative_tolerance;
   settings.variance_tolerance = params_.variance_tolerance;
   settings.initial_lambda = 1e-4;
-  Eigen::VectorXd r;
   double cost = 0.0;
   const PrimitiveShape shape = minimiseSquares(
       initial, k, settings, [&](const PrimitiveShape& s) { return residuals(s, points); },
@@ -230,7 +229,7 @@ ShapeRefiner::Result ShapeRefiner::refineUnchecked(
           return std::nullopt;
         }
       },
-      r, cost);
+      cost);
 
   return covarianceOf(shape, points, cost, all_points.size());
 }

@@ -70,13 +70,13 @@ struct LevenbergMarquardtSettings {
 // settings.max_iterations iterations with up to 10 damped steps each. residuals(state) gives the
 // residual vector (n entries); normalEquations(state, r, H, g) sets H = J^T J and g = J^T r of the
 // residuals' Jacobian J in the step's coordinates; step(state, delta) gives the state moved by
-// delta, or none when delta leaves the state's domain (the step is then rejected). On return, r and
-// cost are those of the returned state.
+// delta, or none when delta leaves the state's domain (the step is then rejected). cost receives
+// the returned state's sum of squared residuals.
 template <typename State, typename Residuals, typename NormalEquations, typename Step>
 State minimiseSquares(State x, int k, const LevenbergMarquardtSettings& settings,
                       Residuals residuals, NormalEquations normalEquations, Step step,
-                      Eigen::VectorXd& r, double& cost) {
-  r = residuals(x);
+                      double& cost) {
+  Eigen::VectorXd r = residuals(x);
   cost = r.squaredNorm();
   const int n = static_cast<int>(r.size());
   LevenbergMarquardtDamping damping(settings.initial_lambda);
